@@ -1,0 +1,1 @@
+"""Built-in executors: ``local`` (process pool) and ``ray`` (a Ray cluster)."""

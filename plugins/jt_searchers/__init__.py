@@ -1,0 +1,1 @@
+"""Built-in searchers: single, random, bds, rmoo, bsoo."""

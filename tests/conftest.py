@@ -1,0 +1,58 @@
+"""Shared fixtures: a temp store, and the third-party example plugin installed into a temp dir."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURE_PLUGIN = ROOT / "tests" / "fixtures" / "jt_example_plugin"
+
+
+@pytest.fixture(scope="session")
+def example_plugin_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """jt-example-plugin installed with pip into a private target directory (a real install)."""
+    target = tmp_path_factory.mktemp("site")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--no-deps", "--no-build-isolation", "-q",
+         "--disable-pip-version-check", "--target", str(target), str(FIXTURE_PLUGIN)],
+        check=True, capture_output=True,
+    )
+    return target
+
+
+@pytest.fixture()
+def example_plugin(example_plugin_dir: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The example plugin importable and discoverable in this process."""
+    from toolkit import plugins
+
+    monkeypatch.syspath_prepend(str(example_plugin_dir))
+    plugins.refresh()
+    yield example_plugin_dir
+    plugins.refresh()
+
+
+@pytest.fixture()
+def store_dir(tmp_path: Path) -> Path:
+    """An empty store root."""
+    return tmp_path / "store"
+
+
+def jt_env(extra_path: Path | None = None) -> dict[str, str]:
+    """Environment for running the ``jt`` command in a subprocess."""
+    env = dict(os.environ)
+    env.pop("JT_STORE", None)
+    if extra_path is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(extra_path), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return env
+
+
+def run_jt(*args: str, extra_path: Path | None = None, cwd: Path | None = None,
+           timeout: float = 300) -> subprocess.CompletedProcess:
+    """Run ``jt ARGS`` as a user would; returns the completed process (text output)."""
+    return subprocess.run([sys.executable, "-m", "toolkit.cli", *args], capture_output=True, text=True,
+                          env=jt_env(extra_path), cwd=cwd, timeout=timeout)

@@ -1,0 +1,191 @@
+"""The ``jt`` command. Imports nothing heavy at module level: ``jt --help`` stays fast.
+
+Every subcommand imports what it needs inside its body. User mistakes (``JtError``) print one line
+``jt: ...`` and exit with status 2; ``--debug`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import List, Optional
+
+import typer
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="jt: discover and learn motion strategies for simulated characters.",
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks (speed is measured here, never in tests).")
+app.add_typer(bench_app, name="bench")
+
+_DEBUG = {"on": False}
+
+
+@app.callback()
+def _main(debug: bool = typer.Option(False, "--debug", help="Show tracebacks for errors.")) -> None:
+    _DEBUG["on"] = debug
+
+
+@app.command("run", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def run_cmd(
+    overrides: Optional[List[str]] = typer.Argument(None, help="Hydra overrides: group=choice, key=value."),
+    cfg: bool = typer.Option(False, "--cfg", help="Print the composed config and exit."),
+) -> None:
+    """Compose the config and run it (e.g. jt run task=highjump search=bds)."""
+    from toolkit.config import compose, to_yaml
+
+    conf = compose(overrides or [])
+    if cfg:
+        typer.echo(to_yaml(conf), nl=False)
+        return
+    if conf.resume:
+        conf = _resume_config(conf)
+    from toolkit.execution.runner import run
+
+    res = run(conf)
+    shown = ", ".join(f"{k}={v:.4g}" for k, v in list(res.metrics.items())[:8])
+    typer.echo(f"run {res.run_id} FINISHED  {shown}")
+    typer.echo(f"  jt show {res.run_id} store={res.store.root}")
+    typer.echo(f"  jt ui store={res.store.root}")
+
+
+def _resume_config(conf):  # type: ignore[no-untyped-def]
+    """The interrupted run's own config, with ``resume`` set (other overrides are ignored)."""
+    from omegaconf import OmegaConf
+
+    from toolkit.config import validate
+    from toolkit.store.tracking import Store, store_root
+
+    store = Store(store_root(str(conf.store)))
+    path = store.workdir(str(conf.resume)) / "config.yaml"
+    store.get_run(str(conf.resume))  # one clear line if the id is unknown
+    if not path.is_file():
+        from toolkit.errors import JtError
+
+        raise JtError(f"run {conf.resume} has no saved config; it cannot be resumed")
+    old = OmegaConf.load(path)
+    old.resume = str(conf.resume)
+    old.store = str(store.root)
+    return validate(old)
+
+
+@app.command("compare", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def compare_cmd(
+    overrides: Optional[List[str]] = typer.Argument(None, help="Overrides shared by every variant."),
+    vary: Optional[List[str]] = typer.Option(None, "--vary", help="KEY=a,b[,c]; repeat for a grid."),
+    seeds: int = typer.Option(1, "--seeds", help="Seeds per variant (0..N-1 added to seed)."),
+    runs: Optional[List[str]] = typer.Option(None, "--runs", help="Compare finished runs instead."),
+) -> None:
+    """Run a grid of variants over seeds and tabulate key metrics (mean ± std)."""
+    from toolkit.execution.compare import compare, compare_runs
+
+    extra_runs = [o for o in (overrides or []) if "=" not in o] if runs else []
+    if runs:
+        res = compare_runs(list(runs) + extra_runs, [o for o in (overrides or []) if "=" in o])
+    else:
+        res = compare(overrides or [], vary or [], seeds)
+    typer.echo(res.table)
+    typer.echo(f"comparison run {res.run_id}: jt show {res.run_id} store={res.store_root}")
+
+
+@app.command("show", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def show_cmd(
+    run_id: str = typer.Argument(..., help="Run id."),
+    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH"),
+) -> None:
+    """Print a run's config, final metrics and artifacts."""
+    from toolkit.execution.show import show
+
+    typer.echo(show(run_id, _store_arg(overrides)))
+
+
+@app.command("ui", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def ui_cmd(
+    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH"),
+    port: int = typer.Option(5000, "--port"),
+) -> None:
+    """Serve the MLflow UI for the store on 127.0.0.1."""
+    import subprocess
+
+    from toolkit.store.tracking import Store, store_root
+
+    store = Store(store_root(_store_arg(overrides)))
+    typer.echo(f"MLflow UI for {store.root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
+    cmd = [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", store.uri,
+           "--host", "127.0.0.1", "--port", str(port)]
+    try:
+        subprocess.run(cmd, check=False)
+    except KeyboardInterrupt:
+        pass
+
+
+@app.command("plugins")
+def plugins_cmd(kind: Optional[str] = typer.Argument(None, help="Only this kind (e.g. spd, search).")) -> None:
+    """List installed plugins: kind, name, distribution, summary (broken ones with the reason)."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    kinds = list(plugins.KINDS)
+    if kind:
+        k = plugins.kind_of(kind)
+        if k is None:
+            raise JtError(f"unknown plugin kind '{kind}'; choose one of: {', '.join(kinds)}")
+        kinds = [k]
+    rows = [("KIND", "NAME", "DISTRIBUTION", "SUMMARY")]
+    for k in kinds:
+        for info in plugins.available(k):
+            status, summary = plugins.describe(info)
+            rows.append((k, info.name, info.dist, summary if status == "ok" else f"BROKEN: {summary}"))
+    widths = [max(len(r[i]) for r in rows) for i in range(3)]
+    for r in rows:
+        typer.echo(f"{r[0]:<{widths[0]}}  {r[1]:<{widths[1]}}  {r[2]:<{widths[2]}}  {r[3]}".rstrip())
+
+
+def _store_arg(overrides: Optional[List[str]]) -> Optional[str]:
+    from toolkit.errors import JtError
+
+    store = None
+    for o in overrides or []:
+        if o.startswith("store="):
+            store = o.split("=", 1)[1]
+        else:
+            raise JtError(f"unexpected argument '{o}'; only store=PATH is accepted here")
+    return store
+
+
+def main() -> None:
+    """Console entry point: one line for user mistakes, exit status 2."""
+    debug = "--debug" in sys.argv
+    try:
+        from toolkit import bench_cli  # noqa: F401  (registers `jt bench ...`; light module)
+
+        app(standalone_mode=False)
+    except Exception as e:  # noqa: BLE001
+        import click
+
+        from toolkit.errors import JtError
+
+        if debug:
+            raise
+        if isinstance(e, click.exceptions.Exit):
+            sys.exit(e.exit_code)
+        if isinstance(e, click.ClickException):
+            typer.echo(f"jt: {e.format_message()}", err=True)
+            sys.exit(2)
+        if isinstance(e, click.exceptions.Abort):
+            typer.echo("jt: aborted", err=True)
+            sys.exit(130)
+        if isinstance(e, JtError):
+            typer.echo(f"jt: {e}", err=True)
+            sys.exit(2)
+        typer.echo(f"jt: internal error: {type(e).__name__}: {e} (rerun with --debug for the traceback)", err=True)
+        sys.exit(1)
+    except KeyboardInterrupt:
+        typer.echo("jt: interrupted", err=True)
+        sys.exit(130)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,1 @@
+"""Run orchestration: compose → searcher ask/tell loop → evaluations (nested runs) → store."""

@@ -1,0 +1,202 @@
+"""``jt compare``: a grid of variants × seeds, then one table and one comparison run.
+
+Every grid cell is an ordinary ``jt run`` (its own outer MLflow run, tagged as a child of the
+comparison run). All cells are composed and checked before anything runs, so a typo in one
+variant costs nothing. Cells run through the configured executor; a parallel executor runs each
+cell with a one-process executor inside, so cores are not oversubscribed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from toolkit.errors import JtError
+
+
+@dataclasses.dataclass
+class CompareResult:
+    """Attributes: table (printable), run_id (the comparison run), store_root, rows."""
+
+    table: str
+    run_id: str
+    store_root: Path
+    rows: list[dict[str, Any]]
+
+
+def parse_vary(vary: Sequence[str]) -> list[tuple[str, list[str]]]:
+    """``["spd=df,maba"]`` → ``[("spd", ["df", "maba"])]``."""
+    out = []
+    for v in vary:
+        if "=" not in v or not v.split("=", 1)[1]:
+            raise JtError(f"bad --vary '{v}': expected KEY=a,b[,c]")
+        key, values = v.split("=", 1)
+        out.append((key.strip(), [s.strip() for s in values.split(",") if s.strip()]))
+    return out
+
+
+def _cell(args: tuple[list[str], bool]) -> tuple[str, dict[str, float]]:
+    overrides, inner_serial = args
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    if inner_serial:
+        overrides = [*overrides, "executor.workers=1"]
+    res = run(compose(overrides))
+    return res.run_id, res.metrics
+
+
+def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> CompareResult:
+    """Run every variant for ``seeds`` seeds and record the comparison."""
+    from toolkit import plugins
+    from toolkit.config import compose
+    from toolkit.store.tracking import Store, store_root
+
+    if seeds < 1:
+        raise JtError("--seeds must be at least 1")
+    grid = parse_vary(vary)
+    if not grid:
+        raise JtError("nothing to compare: give --vary KEY=a,b (or --runs ID ID ...)")
+    base = compose(list(overrides))
+    keys = [k for k, _ in grid]
+    variants = list(itertools.product(*[vals for _, vals in grid]))
+    cells = []
+    for values in variants:
+        for s in range(seeds):
+            ov = [*overrides, *(f"{k}={v}" for k, v in zip(keys, values)), f"seed={int(base.seed) + s}"]
+            cfg = compose(ov)  # check every cell before running any
+            cells.append((values, ov, cfg))
+    store = Store(store_root(str(base.store)))
+    task_cls = plugins.load("task", str(base.task.name))
+    label = ", ".join(f"{k}={','.join(v)}" for k, v in grid)
+    experiment = str(base.task.name)
+    run_id = store.start_run(experiment, run_name=f"compare {label} x{seeds}",
+                             tags={"jt.compare": "true", "jt.vary": label, "jt.seeds": str(seeds)})
+    try:
+        executor = plugins.load("executor", str(base.executor.name))(base.executor)
+        parallel = executor.n_workers > 1 and len(cells) > 1
+        results: list[Any] = [None] * len(cells)
+        try:
+            for i, res in executor.imap(_cell, [(ov, parallel) for _, ov, _ in cells]):
+                results[i] = res
+                store.set_tags(res[0], {"mlflow.parentRunId": run_id, "jt.compare_id": run_id})
+        finally:
+            executor.close()
+        per_cell = [(", ".join(f"{k}={v}" for k, v in zip(keys, values)), rid, m)
+                    for (values, _, _), (rid, m) in zip(cells, results)]
+        out = _record(store, run_id, per_cell, list(getattr(task_cls, "key_metrics", ())), label)
+        store.end_run(run_id, "FINISHED")
+        return out
+    except KeyboardInterrupt:
+        store.end_run(run_id, "KILLED", "interrupted (Ctrl-C)")
+        raise
+    except BaseException as e:
+        store.end_run(run_id, "FAILED", f"{type(e).__name__}: {e}")
+        raise
+
+
+def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareResult:
+    """Compare finished runs: variants are the params that differ between them (seed excepted)."""
+    from toolkit import plugins
+    from toolkit.store.tracking import Store, store_root
+
+    store_path = None
+    for o in overrides:
+        if o.startswith("store="):
+            store_path = o.split("=", 1)[1]
+        else:
+            raise JtError(f"unexpected argument '{o}' with --runs; only store=PATH is accepted")
+    if len(run_ids) < 2:
+        raise JtError("--runs needs at least two run ids")
+    store = Store(store_root(store_path))
+    runs = [store.get_run(r) for r in run_ids]
+    ignore = {"seed", "store", "resume", "run_name"}
+    params = [r.data.params for r in runs]
+    differing = sorted(k for k in set().union(*params) if k not in ignore
+                       and len({p.get(k) for p in params}) > 1)
+    per_cell = []
+    for r, p in zip(runs, params):
+        label = ", ".join(f"{k}={p.get(k)}" for k in differing) or "all"
+        per_cell.append((label, r.info.run_id, dict(r.data.metrics)))
+    task_name = params[0].get("task.name", "")
+    keys: list[str] = []
+    if task_name in plugins.names("task"):
+        keys = list(getattr(plugins.load("task", task_name), "key_metrics", ()))
+    exp = store.client.get_experiment(runs[0].info.experiment_id).name
+    run_id = store.start_run(exp, run_name=f"compare {len(runs)} runs", tags={"jt.compare": "true"})
+    out = _record(store, run_id, per_cell, keys, ", ".join(differing) or "runs")
+    store.end_run(run_id, "FINISHED")
+    return out
+
+
+def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, float]]],
+            keys: list[str], label: str) -> CompareResult:
+    from toolkit.store import h5
+
+    if not keys:  # every metric all runs share
+        common = set.intersection(*(set(m) for _, _, m in per_cell)) if per_cell else set()
+        keys = sorted(common)
+    variants: dict[str, list[tuple[str, dict[str, float]]]] = {}
+    for name, rid, m in per_cell:
+        variants.setdefault(name, []).append((rid, m))
+    rows = []
+    for name, items in variants.items():
+        row: dict[str, Any] = {"variant": name, "n": len(items), "runs": [rid for rid, _ in items]}
+        for k in keys:
+            vals = np.array([m.get(k, math.nan) for _, m in items], dtype=float)
+            row[k] = (float(np.nanmean(vals)) if np.isfinite(vals).any() else math.nan,
+                      float(np.nanstd(vals)) if np.isfinite(vals).any() else math.nan)
+        rows.append(row)
+    table = format_table(rows, keys)
+    wd = store.workdir(run_id)
+    (wd / "compare.txt").write_text(table + "\n")
+    h5.write(wd / "compare.h5", {
+        "variant": np.array([r["variant"] for r in rows], dtype="S"),
+        "n": np.array([r["n"] for r in rows]),
+        "mean": {k: np.array([r[k][0] for r in rows]) for k in keys},
+        "std": {k: np.array([r[k][1] for r in rows]) for k in keys},
+        "runs": {r["variant"].replace("/", "_"): np.array(r["runs"], dtype="S") for r in rows},
+    }, attrs={"format": "jt.compare/1", "vary": label})
+    _plot(rows, keys, wd / "compare.png", label)
+    store.log_artifacts(run_id, wd)
+    store.set_tags(run_id, {"jt.compare.runs": ",".join(rid for _, rid, _ in per_cell)[:5000]})
+    with store.metrics(run_id) as buf:
+        for i, r in enumerate(rows):
+            for k in keys:
+                if not math.isnan(r[k][0]):
+                    buf.add(f"{k}_mean", r[k][0], step=i)
+    return CompareResult(table, run_id, store.root, rows)
+
+
+def format_table(rows: list[dict[str, Any]], keys: list[str]) -> str:
+    """Plain-text table: one row per variant, ``mean ± std`` per key metric."""
+    head = ["variant", "n", *keys]
+    body = [[r["variant"], str(r["n"]), *(f"{r[k][0]:.4g} ± {r[k][1]:.2g}" for k in keys)] for r in rows]
+    widths = [max(len(x[i]) for x in [head, *body]) for i in range(len(head))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(line, widths)).rstrip() for line in [head, *body]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def _plot(rows: list[dict[str, Any]], keys: list[str], path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = max(1, len(keys))
+    fig, axes = plt.subplots(1, n, figsize=(3.2 * n + 1, 3.2), squeeze=False)
+    names = [r["variant"] for r in rows]
+    for ax, k in zip(axes[0], keys):
+        ax.bar(range(len(rows)), [r[k][0] for r in rows], yerr=[r[k][1] for r in rows], capsize=3)
+        ax.set_xticks(range(len(rows)), names, rotation=30, ha="right", fontsize=7)
+        ax.set_title(k, fontsize=9)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)

@@ -1,0 +1,252 @@
+"""``jt run``: one outer MLflow run driving a searcher over a task, evaluations as nested runs.
+
+Flow: start (or reopen, for ``resume=RUN_ID``) the outer run and log config, seed, version and
+commit → build searcher and replay the saved history → loop ``ask`` → evaluate the batch through
+the executor (each point a nested run, its files logged as HDF5/PNG artifacts) → save the history
+→ ``tell`` → finally log the task's summary metrics and the search HDF5. Ctrl-C or SIGTERM ends the
+run as KILLED with the reason, an exception as FAILED; a resumed run continues from the last
+completed evaluation, and an evaluation cut off mid-way finds its own checkpoint in its workdir.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import signal
+import sys
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from toolkit import plugins
+from toolkit.errors import JtError
+from toolkit.execution import provenance
+from toolkit.execution.evaluate import Job, run_job
+from toolkit.execution.history import History, Record
+from toolkit.execution.seeds import derive
+from toolkit.interfaces import EvalContext, Evaluation
+from toolkit.store import h5
+from toolkit.store.tracking import Store, store_root
+
+
+@dataclasses.dataclass
+class RunResult:
+    """What ``run`` returns.
+
+    Attributes:
+        run_id: the outer MLflow run.
+        store: the store it lives in.
+        metrics: the outer run's final metrics.
+        evaluations: every evaluation, in order.
+    """
+
+    run_id: str
+    store: Store
+    metrics: dict[str, float]
+    evaluations: list[Evaluation]
+
+
+def _log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def _eval_metrics(ev: Evaluation, names: list[str]) -> dict[str, float]:
+    out = {k: float(v) for k, v in ev.metrics.items()}
+    for i, f in enumerate(ev.features):
+        out[f"feature_{i}"] = float(f)
+    for i, o in enumerate(ev.objectives):
+        out[f"objective_{names[i] if i < len(names) else i}"] = float(o)
+    out["failed"] = float(ev.failed)
+    return out
+
+
+class _Terminate:
+    """Turns SIGTERM into KeyboardInterrupt while a run is open, so it ends as KILLED."""
+
+    def __enter__(self) -> None:
+        self._old = signal.getsignal(signal.SIGTERM)
+
+        def handler(signum: int, frame: Any) -> None:
+            raise KeyboardInterrupt("terminated (SIGTERM)")
+
+        try:
+            signal.signal(signal.SIGTERM, handler)
+        except ValueError:  # not the main thread
+            self._old = None
+
+    def __exit__(self, *exc: Any) -> None:
+        if self._old is not None:
+            signal.signal(signal.SIGTERM, self._old)
+
+
+def _open_run(store: Store, cfg: Any, experiment: str) -> tuple[str, bool]:
+    """Start a new outer run, or reopen ``cfg.resume``; returns ``(run_id, resumed)``."""
+    from toolkit.config import flatten, to_yaml
+
+    if cfg.resume:
+        run = store.get_run(str(cfg.resume))
+        if run.info.status == "FINISHED":
+            raise JtError(f"run {cfg.resume} already finished; nothing to resume")
+        store.client.update_run(run.info.run_id, status="RUNNING")
+        store.set_tags(run.info.run_id, {"jt.resumed": "true"})
+        return run.info.run_id, True
+    tags = {
+        "jt.version": provenance.jt_version(),
+        "jt.git_commit": provenance.git_commit(),
+        "jt.command": provenance.command_line(),
+        "jt.seed": str(cfg.seed),
+        "jt.task": str(cfg.task.name),
+        "jt.search": str(cfg.search.name),
+        "mlflow.source.name": "jt",
+    }
+    run_id = store.start_run(experiment, run_name=cfg.get("run_name"), tags=tags)
+    store.log_params(run_id, flatten(cfg))
+    cfg_path = store.workdir(run_id) / "config.yaml"
+    cfg_path.write_text(to_yaml(cfg))
+    store.log_artifact(run_id, cfg_path)
+    return run_id, False
+
+
+def _close_stale_children(store: Store, run_id: str, experiment: str) -> None:
+    runs = store.client.search_runs(
+        [store.experiment_id(experiment)],
+        filter_string=f"tags.mlflow.parentRunId = '{run_id}' and attributes.status = 'RUNNING'",
+    )
+    for r in runs:
+        store.end_run(r.info.run_id, "KILLED", "interrupted; re-evaluated when the parent resumed")
+
+
+def run(cfg: Any) -> RunResult:
+    """Run a composed, validated config (see ``toolkit.config.compose``) to completion."""
+    from omegaconf import OmegaConf
+
+    store = Store(store_root(str(cfg.store)))
+    task_cls = plugins.load("task", str(cfg.task.name))
+    search_cls = plugins.load("search", str(cfg.search.name))
+    exec_cls = plugins.load("executor", str(cfg.executor.name))
+    task = task_cls(cfg)
+    problem = task.problem()
+    names = problem.space.names
+    experiment = str(cfg.task.name)
+    nested = bool(getattr(search_cls, "nested", True))
+    container = OmegaConf.to_container(cfg, resolve=True)
+
+    run_id, resumed = _open_run(store, cfg, experiment)
+    workdir = store.workdir(run_id)
+    hist_path = workdir / "search_history.h5"
+    _log(f"jt: run {run_id} ({experiment}){' resumed' if resumed else ''}; store {store.root}")
+    try:
+        with _Terminate():
+            if resumed:
+                _close_stale_children(store, run_id, experiment)
+            history = History.load(hist_path, names)
+            searcher = search_cls(problem, cfg.search, int(cfg.seed))
+            _replay(searcher, history, int(cfg.search.batch))
+            if resumed and len(history):
+                _log(f"jt: resumed after {len(history)} completed evaluation(s)")
+            executor = exec_cls(cfg.executor)
+            try:
+                _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
+                             names, problem, nested, executor, hist_path)
+            finally:
+                executor.close()
+            metrics = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
+        store.end_run(run_id, "FINISHED")
+    except KeyboardInterrupt as e:
+        store.end_run(run_id, "KILLED", str(e) or "interrupted (Ctrl-C)")
+        _log(f"jt: run {run_id} interrupted; continue it with: jt run resume={run_id} store={store.root}")
+        raise
+    except BaseException as e:
+        store.end_run(run_id, "FAILED", f"{type(e).__name__}: {e}")
+        raise
+    return RunResult(run_id, store, metrics, history.evaluations())
+
+
+def _replay(searcher: Any, history: History, batch: int) -> None:
+    for b in range(history.n_batches):
+        recs = history.batch(b)
+        x = np.asarray(searcher.ask(batch), dtype=float)
+        got = np.stack([r.x for r in recs]) if recs else np.zeros((0, x.shape[-1] if x.ndim == 2 else 0))
+        n = min(len(x), len(got))
+        if n == 0 or not np.allclose(x[:n], got[:n], rtol=1e-9, atol=1e-12):
+            raise JtError("cannot resume: the searcher does not repeat its recorded points "
+                          "(config or code changed since the run started)")
+        searcher.tell(x[:n], [r.evaluation for r in recs[:n]])
+
+
+def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experiment: str, task: Any,
+                 searcher: Any, history: History, names: list[str], problem: Any, nested: bool,
+                 executor: Any, hist_path: Path) -> None:
+    budget = int(cfg.search.budget)
+    obj_names = list(problem.objective_names)
+    while not searcher.finished() and len(history) < budget:
+        x = np.asarray(searcher.ask(min(int(cfg.search.batch), budget - len(history))), dtype=float)
+        if x.size == 0:
+            break
+        b, start = history.n_batches, len(history)
+        jobs, child_ids = [], []
+        for j, xi in enumerate(x):
+            idx = start + j
+            point = problem.space.to_dict(xi)
+            ctx = EvalContext(index=idx, seed=derive(int(cfg.seed), idx),
+                              workdir=store.workdir(run_id, f"eval_{idx:04d}"))
+            child = run_id
+            if nested:
+                child = store.start_run(experiment, run_name=f"eval-{idx:04d}", parent_run_id=run_id,
+                                        tags={"jt.eval_index": str(idx), "jt.seed": str(ctx.seed)})
+                store.log_params(child, {**point, "seed": ctx.seed})
+            child_ids.append(child)
+            jobs.append(Job(container, point, ctx, verbose=executor.n_workers == 1))
+        evs: list[Optional[Evaluation]] = [None] * len(jobs)
+        for j, (ev, secs) in executor.imap(run_job, jobs):
+            evs[j] = ev
+            _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs)
+            history.add(Record(start + j, b, x[j], ev, child_ids[j] if nested else ""))
+            if nested:
+                store.end_run(child_ids[j], "FINISHED")
+            shown = ", ".join(f"{k}={v:.4g}" for k, v in list(ev.metrics.items())[:4])
+            _log(f"jt: [{len(history)}/{budget}] eval {start + j} in {secs:.1f}s"
+                 f"{' FAILED: ' + ev.reason if ev.failed else ''} {shown}")
+        history.save(hist_path)
+        searcher.tell(x, evs)
+
+
+def _log_evaluation(store: Store, run_id: str, ev: Evaluation, workdir: Path, obj_names: list[str],
+                    secs: float) -> None:
+    with store.metrics(run_id) as buf:
+        for key, series in ev.history.items():
+            for step, value in series:
+                buf.add(key, value, int(step))
+        buf.add_many({**_eval_metrics(ev, obj_names), "eval_seconds": secs})
+    if ev.failed:
+        store.set_tags(run_id, {"jt.failure": ev.reason or "failed"})
+    if ev.artifacts is None:
+        store.log_artifacts(run_id, workdir)
+    else:
+        for name in ev.artifacts:
+            store.log_artifact(run_id, workdir / name)
+
+
+def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: History, workdir: Path,
+            hist_path: Path, nested: bool) -> dict[str, float]:
+    evs = history.evaluations()
+    out_dir = workdir / "summary"
+    out_dir.mkdir(exist_ok=True)
+    metrics = {k: float(v) for k, v in (task.summarize(evs, out_dir) or {}).items()}
+    metrics["n_evaluations"] = float(len(evs))
+    metrics["n_failed"] = float(sum(e.failed for e in evs))
+    if nested and evs:
+        for key in getattr(task, "key_metrics", ()):
+            vals = [e.metrics[key] for e in evs if key in e.metrics and not math.isnan(e.metrics[key])]
+            if vals and key not in metrics:
+                metrics[f"best_{key}"] = float(max(vals))
+    with store.metrics(run_id) as buf:
+        buf.add_many(metrics)
+    h5.write(out_dir / "search.h5", {"history": history.arrays(), "searcher": searcher.summary() or {}},
+             attrs={"format": "jt.search/1"})
+    history.save(hist_path)
+    store.log_artifacts(run_id, out_dir)
+    store.log_artifact(run_id, hist_path)
+    return metrics
+

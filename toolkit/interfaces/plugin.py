@@ -1,0 +1,45 @@
+"""The base every plugin class derives from."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, ClassVar
+
+
+@dataclasses.dataclass
+class NoConfig:
+    """A plugin that takes no parameters."""
+
+
+class Plugin:
+    """Base of every plugin class.
+
+    A plugin declares its parameters as a dataclass in ``Config`` (one field per YAML key, each
+    with a docstring-style comment); ``toolkit.config`` validates the plugin's config group against
+    it, so an unknown key or a wrong type is one clear error before anything runs. The first line
+    of the class docstring is the summary ``jt plugins`` prints.
+
+    Attributes:
+        Config: dataclass of the plugin's parameters.
+        name: the registry name, filled in by the registry when the class is loaded.
+    """
+
+    Config: ClassVar[type] = NoConfig
+    name: ClassVar[str] = ""
+
+    @classmethod
+    def summary(cls) -> str:
+        """First line of the class docstring."""
+        doc = (cls.__doc__ or "").strip()
+        return doc.splitlines()[0].strip() if doc else ""
+
+    @staticmethod
+    def params_of(cfg: Any) -> dict:
+        """Plain dict of a group node without the bookkeeping key ``name``."""
+        from omegaconf import OmegaConf
+
+        if cfg is None:
+            return {}
+        d = OmegaConf.to_container(cfg, resolve=True) if not isinstance(cfg, dict) else dict(cfg)
+        d.pop("name", None)
+        return d

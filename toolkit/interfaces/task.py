@@ -1,0 +1,93 @@
+"""Tasks (``jt.tasks``): what one evaluation does, and what a run measures."""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+from pathlib import Path
+from typing import Any, Callable, ClassVar, Optional, Sequence
+
+from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.searcher import SearchProblem, Space
+
+
+@dataclasses.dataclass
+class EvalContext:
+    """Where and how one evaluation runs (possibly in a worker process).
+
+    Attributes:
+        index: evaluation number within the run (0-based).
+        seed: seed for this evaluation, derived deterministically from the run seed and index.
+        workdir: directory for this evaluation's files (HDF5 artifacts, PNGs, checkpoints). It
+            survives an interruption, so an evaluation can resume from a checkpoint found there.
+            Every file left in it is logged as an artifact of the evaluation's MLflow run.
+        progress: optional callback ``progress(fraction, message)`` for long work.
+    """
+
+    index: int
+    seed: int
+    workdir: Path
+    progress: Optional[Callable[[float, str], None]] = None
+
+    def report(self, fraction: float, message: str = "") -> None:
+        """Report progress in ``[0, 1]`` if anyone listens."""
+        if self.progress is not None:
+            self.progress(fraction, message)
+
+
+@dataclasses.dataclass
+class Evaluation:
+    """What one evaluation returns to the runner (and through it to the searcher and MLflow).
+
+    Attributes:
+        metrics: final scalar metrics, logged on the evaluation's run.
+        features: strategy feature vector ``(n_features,)`` (BDS), or empty.
+        objectives: objective values ``(n_objectives,)``, all minimised (RMOO/BSOO), or empty.
+        failed: True when the evaluation failed as the task defines failure (a fall, NaN state);
+            a failure is a result, not an error.
+        reason: why it failed.
+        history: metric curves ``{name: [(step, value), ...]}``, logged with ``log_batch``.
+        artifacts: names of files in the workdir to log (default: every file there).
+        point: the parameters evaluated (filled in by the runner).
+    """
+
+    metrics: dict[str, float] = dataclasses.field(default_factory=dict)
+    features: Sequence[float] = ()
+    objectives: Sequence[float] = ()
+    failed: bool = False
+    reason: str = ""
+    history: dict[str, list[tuple[int, float]]] = dataclasses.field(default_factory=dict)
+    artifacts: Optional[list[str]] = None
+    point: dict[str, float] = dataclasses.field(default_factory=dict)
+
+
+class Task(Plugin, abc.ABC):
+    """An experiment: what one evaluation does and which metrics matter.
+
+    A task is built from the whole composed run config (it picks its simulator, SPD backend,
+    action space, rewards and curriculum from it through the registry). It must be cheap to
+    construct; heavy set-up happens in ``evaluate``, which may run in a worker process.
+
+    Attributes:
+        key_metrics: the metrics ``jt compare`` tabulates (mean ± std over seeds).
+
+    Args:
+        cfg: the whole composed run config (``cfg.task`` is this task's group).
+    """
+
+    key_metrics: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, cfg: Any) -> None:
+        self.cfg = cfg
+
+    def problem(self) -> SearchProblem:
+        """The outer search problem; by default an empty box (the task runs once)."""
+        return SearchProblem(space=Space(params=()))
+
+    @abc.abstractmethod
+    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
+        """Run one evaluation at ``point`` (names of ``problem().space``)."""
+
+    def summarize(self, evaluations: Sequence[Evaluation], workdir: Path) -> dict[str, float]:
+        """Run-level metrics over all evaluations; may write files (tables, plots) to ``workdir``."""
+        return {}

@@ -1,0 +1,187 @@
+"""MLflow tracking for jt: one SQLite store per root, buffered metrics, explicit run ids.
+
+Everything goes through ``MlflowClient`` with explicit run ids (never MLflow's global "active
+run"), so a driver can keep an outer run and many nested evaluation runs open at once, and two jt
+processes can share a store. Creating a fresh store is serialised with a lock file, because two
+processes running MLflow's schema migrations on the same new database at once would collide.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import logging
+import os
+import time
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator, Mapping, Optional
+
+from toolkit.errors import JtError
+
+MAX_PARAMS_PER_BATCH = 100
+MAX_METRICS_PER_BATCH = 1000
+
+
+def store_root(path: Optional[str] = None) -> Path:
+    """Absolute store root: ``path``, else ``$JT_STORE``, else ``./artifacts``."""
+    return Path(path or os.environ.get("JT_STORE") or "artifacts").expanduser().resolve()
+
+
+@contextmanager
+def _locked(root: Path) -> Iterator[None]:
+    root.mkdir(parents=True, exist_ok=True)
+    with open(root / ".jt.lock", "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+class Store:
+    """A jt store: ``<root>/mlflow.db`` for tracking, ``<root>/runs/<experiment>/<run>/artifacts``
+    for artifacts, ``<root>/work/<run>/`` for evaluation working folders (checkpoints).
+
+    Args:
+        root: store directory (created if missing).
+    """
+
+    def __init__(self, root: str | os.PathLike) -> None:
+        self.root = Path(root).resolve()
+        self.uri = f"sqlite:///{self.root / 'mlflow.db'}"
+        from mlflow.tracking import MlflowClient
+
+        for name in ("alembic", "mlflow", "sqlalchemy"):  # after import: mlflow sets its own levels
+            logging.getLogger(name).setLevel(logging.WARNING)
+
+        with _locked(self.root):
+            self.client = MlflowClient(tracking_uri=self.uri)
+            self.client.search_experiments(max_results=1)  # creates/migrates the schema under the lock
+
+    # ---- experiments and runs ------------------------------------------------------------
+    def experiment_id(self, name: str) -> str:
+        """Id of experiment ``name``, created with its artifacts under ``<root>/runs/<name>``."""
+        exp = self.client.get_experiment_by_name(name)
+        if exp is not None:
+            return exp.experiment_id
+        location = str(self.root / "runs" / name)
+        try:
+            return self.client.create_experiment(name, artifact_location=location)
+        except Exception:  # noqa: BLE001 - another process created it first
+            exp = self.client.get_experiment_by_name(name)
+            if exp is None:
+                raise
+            return exp.experiment_id
+
+    def start_run(
+        self,
+        experiment: str,
+        run_name: Optional[str] = None,
+        tags: Optional[Mapping[str, str]] = None,
+        parent_run_id: Optional[str] = None,
+    ) -> str:
+        """Create a RUNNING run; returns its id."""
+        tags = dict(tags or {})
+        if parent_run_id:
+            tags["mlflow.parentRunId"] = parent_run_id
+        run = self.client.create_run(self.experiment_id(experiment), run_name=run_name, tags=tags)
+        return run.info.run_id
+
+    def end_run(self, run_id: str, status: str = "FINISHED", reason: Optional[str] = None) -> None:
+        """Close a run with ``FINISHED``, ``FAILED`` or ``KILLED`` (and the reason as a tag)."""
+        if reason:
+            self.client.set_tag(run_id, "jt.reason", reason[:5000])
+        self.client.set_terminated(run_id, status=status)
+
+    def get_run(self, run_id: str) -> Any:
+        """The MLflow run; a one-line ``JtError`` if there is none with that id."""
+        try:
+            return self.client.get_run(run_id)
+        except Exception as e:  # noqa: BLE001
+            raise JtError(f"no run '{run_id}' in the store {self.root}") from e
+
+    def artifact_dir(self, run_id: str) -> Path:
+        """Local folder of a run's artifacts."""
+        uri = self.get_run(run_id).info.artifact_uri
+        if uri.startswith("file://"):
+            uri = uri[len("file://"):]
+        return Path(uri)
+
+    def workdir(self, run_id: str, name: str = "") -> Path:
+        """Working folder of a run (kept across resumes), created if missing."""
+        d = self.root / "work" / run_id / name if name else self.root / "work" / run_id
+        d.mkdir(parents=True, exist_ok=True)
+        return d
+
+    # ---- logging -------------------------------------------------------------------------
+    def log_params(self, run_id: str, params: Mapping[str, Any]) -> None:
+        """Log params in batches of 100 (values longer than MLflow's limit are cut)."""
+        from mlflow.entities import Param
+
+        items = [Param(str(k), str(v)[:6000]) for k, v in params.items()]
+        for i in range(0, len(items), MAX_PARAMS_PER_BATCH):
+            self.client.log_batch(run_id, params=items[i : i + MAX_PARAMS_PER_BATCH])
+
+    def set_tags(self, run_id: str, tags: Mapping[str, Any]) -> None:
+        """Set several tags in one call."""
+        from mlflow.entities import RunTag
+
+        if tags:
+            self.client.log_batch(run_id, tags=[RunTag(str(k), str(v)) for k, v in tags.items()])
+
+    def log_artifacts(self, run_id: str, folder: str | os.PathLike, artifact_path: Optional[str] = None) -> None:
+        """Copy every file under ``folder`` into the run's artifacts (skipping temp files)."""
+        folder = Path(folder)
+        for p in sorted(folder.rglob("*")):
+            if p.is_file() and ".tmp-" not in p.name and p.suffix != ".lock":
+                rel = p.parent.relative_to(folder)
+                sub = str(Path(artifact_path) / rel) if artifact_path else (str(rel) if str(rel) != "." else None)
+                self.client.log_artifact(run_id, str(p), artifact_path=sub)
+
+    def log_artifact(self, run_id: str, path: str | os.PathLike, artifact_path: Optional[str] = None) -> None:
+        """Copy one file into the run's artifacts."""
+        self.client.log_artifact(run_id, str(path), artifact_path=artifact_path)
+
+    def metrics(self, run_id: str) -> "MetricBuffer":
+        """A metric buffer for ``run_id`` (flush it, or use it as a context manager)."""
+        return MetricBuffer(self, run_id)
+
+
+class MetricBuffer:
+    """Collects metrics and writes them with ``log_batch`` (one ``log_metric`` costs ~8 ms).
+
+    Args:
+        store: the store.
+        run_id: run the metrics belong to.
+        flush_every: flush automatically once this many metrics are waiting.
+    """
+
+    def __init__(self, store: Store, run_id: str, flush_every: int = MAX_METRICS_PER_BATCH) -> None:
+        self.store, self.run_id, self.flush_every = store, run_id, flush_every
+        self._items: list[Any] = []
+
+    def add(self, key: str, value: float, step: int = 0, timestamp: Optional[int] = None) -> None:
+        """Queue one metric value (NaN/inf are logged as they are; MLflow accepts them)."""
+        from mlflow.entities import Metric
+
+        ts = timestamp if timestamp is not None else int(time.time() * 1000)
+        self._items.append(Metric(str(key), float(value), ts, int(step)))
+        if len(self._items) >= self.flush_every:
+            self.flush()
+
+    def add_many(self, values: Mapping[str, float], step: int = 0) -> None:
+        """Queue several metrics at one step."""
+        for k, v in values.items():
+            self.add(k, v, step)
+
+    def flush(self) -> None:
+        """Write everything queued."""
+        while self._items:
+            chunk, self._items = self._items[:MAX_METRICS_PER_BATCH], self._items[MAX_METRICS_PER_BATCH:]
+            self.store.client.log_batch(self.run_id, metrics=chunk)
+
+    def __enter__(self) -> "MetricBuffer":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.flush()
