@@ -1,0 +1,165 @@
+"""Velocities (finite differences) and forward kinematics (PyBullet) of mocap poses."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+from typing import TYPE_CHECKING, Iterator
+
+import numpy as np
+
+from toolkit.motion import rotations as rot
+from toolkit.motion.skeletons import SPHERICAL, Skeleton
+
+if TYPE_CHECKING:  # pragma: no cover
+    from toolkit.motion.clips import Clip
+
+
+@dataclasses.dataclass
+class Velocities:
+    """Velocities at a clip's frames.
+
+    Attributes:
+        root_lin: root linear velocity in the world frame ``(n_frames, 3)``.
+        root_ang: root angular velocity in the world frame ``(n_frames, 3)``.
+        joints: joint velocities in the dof layout ``(n_frames, n_dof)``: a spherical joint's
+            angular velocity in its child (local) frame, as PyBullet's ``resetJointStatesMultiDof``
+            and DeepMimic's ``ComputeAngVelRel`` use; a revolute joint's angle rate.
+    """
+
+    root_lin: np.ndarray
+    root_ang: np.ndarray
+    joints: np.ndarray
+
+
+def clip_velocities(clip: "Clip") -> Velocities:
+    """Central differences between the neighbouring frames of every frame.
+
+    At the ends a looping clip takes its neighbours from the previous / next cycle (via
+    ``Clip.sample``, root shifted by the cycle offset); a non-looping clip uses one-sided
+    differences. Rotations are differenced on the group: ``log(q_next q_prev^-1) / dt`` (world)
+    for the root, ``log(q_prev^-1 q_next) / dt`` (local) for joints, exact for constant angular
+    velocity up to ``pi`` per two frames.
+    """
+    t = clip.times
+    n = clip.n_frames
+    idx_prev = np.concatenate([[0], np.arange(n - 1)])
+    idx_next = np.concatenate([np.arange(1, n), [n - 1]])
+    t_prev, t_next = t[idx_prev].copy(), t[idx_next].copy()
+    pp, rp, jp = clip.root_pos[idx_prev].copy(), clip.root_rot[idx_prev].copy(), clip.joints[idx_prev].copy()
+    pn, rn, jn = clip.root_pos[idx_next].copy(), clip.root_rot[idx_next].copy(), clip.joints[idx_next].copy()
+    if clip.loop:
+        t_prev[0] = -(t[-1] - t[-2])
+        t_next[-1] = t[-1] + (t[1] - t[0])
+        a = clip.sample(np.array([t_prev[0], t_next[-1]]))
+        pp[0], rp[0], jp[0] = a[0][0], a[1][0], a[2][0]
+        pn[-1], rn[-1], jn[-1] = a[0][1], a[1][1], a[2][1]
+    dt = (t_next - t_prev)[:, None]
+    root_lin = (pn - pp) / dt
+    root_ang = rot.quat_to_expmap(rot.quat_multiply(rn, rot.quat_conjugate(rp))) / dt
+    parts = []
+    sk = clip.skeleton
+    for j, s in zip(sk.joints, sk.q_slices.values()):
+        if j.kind == SPHERICAL:
+            parts.append(rot.quat_to_expmap(rot.quat_relative(jp[:, s], jn[:, s])) / dt)
+        else:
+            parts.append((jn[:, s] - jp[:, s]) / dt)
+    return Velocities(root_lin, root_ang, np.concatenate(parts, axis=1))
+
+
+@dataclasses.dataclass
+class Kinematics:
+    """World-frame link poses from forward kinematics.
+
+    Attributes:
+        links: link names, index = PyBullet link index.
+        link_com: link centres of mass ``(n_frames, n_links, 3)`` ("link positions").
+        joint_pos: link frame origins = joint positions ``(n_frames, n_links, 3)``.
+        link_rot: link frame orientations ``x, y, z, w`` ``(n_frames, n_links, 4)``.
+    """
+
+    links: tuple[str, ...]
+    link_com: np.ndarray
+    joint_pos: np.ndarray
+    link_rot: np.ndarray
+
+    def index(self, name: str) -> int:
+        return self.links.index(name)
+
+
+@contextlib.contextmanager
+def bullet_character(skeleton: Skeleton, client: int | None = None) -> Iterator[tuple[int, int]]:
+    """A PyBullet DIRECT client (or the given one) with the skeleton's URDF loaded.
+
+    Yields:
+        ``(client id, body id)``; a client opened here is disconnected on exit, a body loaded
+        into a given client is removed.
+    """
+    import pybullet as pb
+    import pybullet_data
+
+    own = client is None
+    cid = pb.connect(pb.DIRECT) if own else client
+    try:
+        pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=cid)
+        body = pb.loadURDF(
+            skeleton.urdf, globalScaling=skeleton.scale, useFixedBase=False,
+            flags=pb.URDF_MAINTAIN_LINK_ORDER, physicsClientId=cid,
+        )  # fmt: skip
+        try:
+            yield cid, body
+        finally:
+            if not own:
+                pb.removeBody(body, physicsClientId=cid)
+    finally:
+        if own:
+            pb.disconnect(cid)
+
+
+def forward_kinematics(
+    skeleton: Skeleton,
+    root_pos: np.ndarray,
+    root_rot: np.ndarray,
+    joints: np.ndarray,
+    client: int | None = None,
+) -> Kinematics:
+    """Link poses of each pose by PyBullet (``resetBasePositionAndOrientation``,
+    ``resetJointStatesMultiDof``, ``getLinkStates``): PyBullet is the reference, not a re-derivation.
+
+    Args:
+        skeleton: the character.
+        root_pos: root (base) positions ``(n, 3)``.
+        root_rot: root orientations ``x, y, z, w`` ``(n, 4)``.
+        joints: poses in the quaternion layout ``(n, n_q)``.
+        client: an existing PyBullet client to use; a private DIRECT one when ``None``.
+
+    Returns:
+        ``Kinematics`` with arrays ``(n, n_links, ...)``.
+    """
+    import pybullet as pb
+
+    root_pos = np.atleast_2d(np.asarray(root_pos, dtype=np.float64))
+    root_rot = np.atleast_2d(np.asarray(root_rot, dtype=np.float64))
+    joints = np.atleast_2d(np.asarray(joints, dtype=np.float64))
+    n, n_links = root_pos.shape[0], len(skeleton.links)
+    com = np.empty((n, n_links, 3))
+    org = np.empty((n, n_links, 3))
+    ori = np.empty((n, n_links, 4))
+    indices = [j.bullet_index for j in skeleton.joints]
+    slices = list(skeleton.q_slices.values())
+    link_ids = list(range(n_links))
+    with bullet_character(skeleton, client) as (cid, body):
+        n_urdf = pb.getNumJoints(body, physicsClientId=cid)
+        if n_urdf != n_links:
+            raise RuntimeError(f"{skeleton.urdf} has {n_urdf} links, the {skeleton.name} table {n_links}")
+        for i in range(n):
+            pb.resetBasePositionAndOrientation(body, root_pos[i].tolist(), root_rot[i].tolist(), physicsClientId=cid)
+            pb.resetJointStatesMultiDof(
+                body, indices, [joints[i, s].tolist() for s in slices], physicsClientId=cid
+            )
+            states = pb.getLinkStates(body, link_ids, computeForwardKinematics=True, physicsClientId=cid)
+            for k, st in enumerate(states):
+                com[i, k] = st[0]
+                org[i, k] = st[4]
+                ori[i, k] = st[5]
+    return Kinematics(tuple(skeleton.links), com, org, ori)
