@@ -1,3 +1,101 @@
-"""``jt bench ...`` subcommands (registered on import; heavy imports inside each command)."""
+"""``jt bench ...``: benchmarks. Speed is measured here, never in tests; quote ratios from one run."""
 
 from __future__ import annotations
+
+import json
+import platform
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from toolkit.cli import bench_app
+from toolkit.errors import JtError
+
+MODELS = ("humanoid", "laikago", "atlas", "snake36", "snake72", "snake195")
+BACKENDS = ("df", "sf", "pcg", "maba", "bullet")
+
+
+def _split(value: str, valid: tuple[str, ...], what: str) -> list[str]:
+    items = [v.strip() for v in value.split(",") if v.strip()]
+    bad = [v for v in items if v not in valid]
+    if bad or not items:
+        raise JtError(f"unknown {what} '{','.join(bad) or value}'; choose from: {', '.join(valid)}")
+    return items
+
+
+def machine_info() -> dict:
+    """What the numbers were measured on."""
+    import os
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
+            "platform": platform.platform()}
+
+
+@bench_app.command("spd")
+def bench_spd(
+    models: str = typer.Option("humanoid,snake36,snake72,snake195", "--models", help=f"Comma list of {', '.join(MODELS)}."),
+    backends: str = typer.Option("df,sf,pcg,maba,bullet", "--backends", help=f"Comma list of {', '.join(BACKENDS)}."),
+    samples: int = typer.Option(200, "--samples", help="Timed calls per (model, backend)."),
+    seed: int = typer.Option(0, "--seed"),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Log-log plot of solve time vs DoF (PNG)."),
+    check: bool = typer.Option(False, "--check", help="Only check that all backends agree (≤ 1e-8)."),
+) -> None:
+    """Time the SPD solve and the whole simulation step per model and backend (thesis Tables 2.2/2.3)."""
+    from toolkit.dynamics import bench
+
+    model_list = _split(models, MODELS, "model")
+    if check:
+        worst = bench.check_agreement(model_list, n_states=20, seed=seed)
+        typer.echo(f"largest relative torque difference between backends: {worst:.3e} (limit 1e-8)")
+        if not worst <= 1e-8:
+            raise typer.Exit(1)
+        return
+    backend_list = _split(backends, BACKENDS, "backend")
+    rows = bench.time_spd(model_list, backend_list, n_samples=samples, seed=seed)
+    header = f"{'model':<10} {'dof':>4} {'depth':>5} {'backend':<8} {'solve_us':>10} {'step_us':>10} {'share%':>7}"
+    typer.echo(header)
+    for r in rows:
+        share = 100.0 * r["solve_us_median"] / r["step_us_median"] if r.get("step_us_median") else float("nan")
+        typer.echo(f"{r['model']:<10} {r['dof']:>4} {r['depth']:>5} {r['backend']:<8} "
+                   f"{r['solve_us_median']:>10.1f} {r['step_us_median']:>10.1f} {share:>7.1f}")
+    result = {"machine": machine_info(), "results": rows}
+    if json_out:
+        json_out.parent.mkdir(parents=True, exist_ok=True)
+        json_out.write_text(json.dumps(result, indent=2))
+        typer.echo(f"wrote {json_out}")
+    png = plot or (json_out.with_suffix(".png") if json_out else None)
+    if png:
+        _plot(rows, png)
+        typer.echo(f"wrote {png}")
+
+
+def _plot(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 4))
+    for b in sorted({r["backend"] for r in rows}):
+        pts = sorted((r["dof"], r["solve_us_median"]) for r in rows if r["backend"] == b and r["solve_us_median"] == r["solve_us_median"])
+        if pts:
+            ax.plot(*zip(*pts), marker="o", label=b)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("degrees of freedom")
+    ax.set_ylabel("SPD solve time (µs, median)")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

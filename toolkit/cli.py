@@ -36,12 +36,15 @@ def run_cmd(
     """Compose the config and run it (e.g. jt run task=highjump search=bds)."""
     from toolkit.config import compose, to_yaml
 
-    conf = compose(overrides or [])
+    ov = list(overrides or [])
+    resume = [o.split("=", 1)[1] for o in ov if o.startswith("resume=")]
+    if resume and resume[0] not in ("", "null"):
+        conf = _resume_config(resume[0], ov)
+    else:
+        conf = compose(ov)
     if cfg:
         typer.echo(to_yaml(conf), nl=False)
         return
-    if conf.resume:
-        conf = _resume_config(conf)
     from toolkit.execution.runner import run
 
     res = run(conf)
@@ -51,22 +54,25 @@ def run_cmd(
     typer.echo(f"  jt ui store={res.store.root}")
 
 
-def _resume_config(conf):  # type: ignore[no-untyped-def]
-    """The interrupted run's own config, with ``resume`` set (other overrides are ignored)."""
+def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untyped-def]
+    """The interrupted run's own saved config with ``resume`` set (only ``store=`` may be added)."""
     from omegaconf import OmegaConf
 
     from toolkit.config import validate
+    from toolkit.errors import JtError
     from toolkit.store.tracking import Store, store_root
 
-    store = Store(store_root(str(conf.store)))
-    path = store.workdir(str(conf.resume)) / "config.yaml"
-    store.get_run(str(conf.resume))  # one clear line if the id is unknown
+    others = [o for o in overrides if not o.startswith(("resume=", "store="))]
+    if others:
+        raise JtError(f"resume= continues a run with its own config; drop: {' '.join(others)}")
+    stores = [o.split("=", 1)[1] for o in overrides if o.startswith("store=")]
+    store = Store(store_root(stores[0] if stores else None))
+    store.get_run(run_id)  # one clear line if the id is unknown
+    path = store.workdir(run_id) / "config.yaml"
     if not path.is_file():
-        from toolkit.errors import JtError
-
-        raise JtError(f"run {conf.resume} has no saved config; it cannot be resumed")
+        raise JtError(f"run {run_id} has no saved config in {store.root}; it cannot be resumed")
     old = OmegaConf.load(path)
-    old.resume = str(conf.resume)
+    old.resume = run_id
     old.store = str(store.root)
     return validate(old)
 
@@ -161,7 +167,11 @@ def main() -> None:
     try:
         from toolkit import bench_cli  # noqa: F401  (registers `jt bench ...`; light module)
 
-        app(standalone_mode=False)
+        rc = app(standalone_mode=False)
+        if isinstance(rc, int) and rc:  # typer turns Ctrl-C into exit code 130 and returns it
+            if rc == 130:
+                typer.echo("jt: interrupted", err=True)
+            sys.exit(rc)
     except Exception as e:  # noqa: BLE001
         import click
 

@@ -1,0 +1,39 @@
+"""jt compare: a grid over seeds becomes one table, one HDF5, one PNG and a comparison run."""
+
+import numpy as np
+
+from toolkit.execution.compare import compare, compare_runs, parse_vary
+from toolkit.store import h5
+
+
+def test_grid_table_and_comparison_run(example_plugin, store_dir):
+    res = compare(["task=quadratic", "executor.workers=1", f"store={store_dir}"],
+                  ["task.centre=0.0,0.5"], seeds=2)
+    assert [r["variant"] for r in res.rows] == ["task.centre=0.0", "task.centre=0.5"]
+    assert all(r["n"] == 2 for r in res.rows)
+    # the default point is (0, 0): value = 2 * centre^2 exactly, with no spread over seeds
+    assert np.isclose(res.rows[0]["value"][0], 0.0) and np.isclose(res.rows[1]["value"][0], 0.5)
+    assert "value" in res.table.splitlines()[0] and "0.5 ± 0" in res.table
+    from toolkit.store.tracking import Store
+
+    store = Store(store_dir)
+    art = store.artifact_dir(res.run_id)
+    table = h5.read(art / "compare.h5")
+    np.testing.assert_allclose(table["mean"]["value"], [0.0, 0.5])
+    assert (art / "compare.png").stat().st_size > 1000
+    tags = store.get_run(res.run_id).data.tags
+    child_ids = tags["jt.compare.runs"].split(",")
+    assert len(child_ids) == 4
+    assert all(store.get_run(c).data.tags["mlflow.parentRunId"] == res.run_id for c in child_ids)
+    again = compare_runs(child_ids, [f"store={store_dir}"])
+    assert [r["variant"] for r in again.rows] == ["task.centre=0.0", "task.centre=0.5"]
+
+
+def test_parse_vary_rejects_bad_syntax():
+    import pytest
+
+    from toolkit.errors import JtError
+
+    assert parse_vary(["a=1,2", "b=x"]) == [("a", ["1", "2"]), ("b", ["x"])]
+    with pytest.raises(JtError):
+        parse_vary(["nokey"])

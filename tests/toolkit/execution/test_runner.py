@@ -1,0 +1,138 @@
+"""The runner end to end on the third-party example task: nested runs, artifacts, resume."""
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from tests.conftest import jt_env
+from toolkit.config import compose
+from toolkit.execution.runner import run
+from toolkit.store import h5
+
+
+def test_search_runs_evaluations_as_nested_runs(example_plugin, store_dir):
+    cfg = compose(["task=quadratic", "search=random", "search.budget=4", "search.batch=2",
+                   "executor.workers=1", f"store={store_dir}", "seed=3"])
+    res = run(cfg)
+    store = res.store
+    outer = store.get_run(res.run_id)
+    assert outer.info.status == "FINISHED"
+    assert outer.data.tags["jt.seed"] == "3" and "jt.git_commit" in outer.data.tags
+    assert outer.data.params["task.name"] == "quadratic"
+    children = store.client.search_runs([outer.info.experiment_id],
+                                        filter_string=f"tags.mlflow.parentRunId = '{res.run_id}'")
+    assert len(children) == 4 and all(c.info.status == "FINISHED" for c in children)
+    for c in children:
+        art = store.artifact_dir(c.info.run_id)
+        data = h5.read(art / "evaluation.h5")
+        assert np.isclose(data["value"], c.data.metrics["value"])
+        assert {"feature_0", "objective_value", "eval_seconds"} <= set(c.data.metrics)
+        assert len(store.client.get_metric_history(c.info.run_id, "curve")) == 5
+    hist = h5.read(store.artifact_dir(res.run_id) / "search_history.h5")
+    assert hist["x"].shape == (4, 2) and list(hist["batch"]) == [0, 0, 1, 1]
+    assert outer.data.metrics["n_evaluations"] == 4
+
+
+def test_same_seed_same_result(example_plugin, store_dir):
+    a = run(compose(["task=quadratic", "search=random", "search.budget=3", "executor.workers=1",
+                     f"store={store_dir}", "seed=5"]))
+    b = run(compose(["task=quadratic", "search=random", "search.budget=3", "executor.workers=1",
+                     f"store={store_dir}", "seed=5"]))
+    c = run(compose(["task=quadratic", "search=random", "search.budget=3", "executor.workers=1",
+                     f"store={store_dir}", "seed=6"]))
+    va = [e.metrics["noise0"] for e in a.evaluations]
+    assert va == [e.metrics["noise0"] for e in b.evaluations]
+    assert va != [e.metrics["noise0"] for e in c.evaluations]
+
+
+def test_parallel_executor_gives_the_same_results(example_plugin, store_dir):
+    common = ["task=quadratic", "search=random", "search.budget=4", "search.batch=4",
+              f"store={store_dir}", "seed=2"]
+    serial = run(compose([*common, "executor.workers=1"]))
+    pooled = run(compose([*common, "executor.workers=2"]))
+    assert [e.metrics for e in serial.evaluations] == [e.metrics for e in pooled.evaluations]
+
+
+def _runs(db):
+    con = sqlite3.connect(db)
+    try:
+        return con.execute("select run_uuid, status from runs").fetchall()
+    except sqlite3.OperationalError:
+        return []
+    finally:
+        con.close()
+
+
+def test_killed_run_resumes_from_last_completed_evaluation(example_plugin, example_plugin_dir, store_dir):
+    args = [sys.executable, "-m", "toolkit.cli", "run", "task=quadratic", "task.sleep=1.0",
+            "search=random", "search.budget=6", "executor.workers=1", f"store={store_dir}", "seed=1"]
+    proc = subprocess.Popen(args, env=jt_env(example_plugin_dir), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    db = store_dir / "mlflow.db"
+    deadline = time.time() + 120
+    outer = None
+    while time.time() < deadline:  # wait until two evaluations have finished
+        done = [r for r in _runs(db) if r[1] == "FINISHED"] if db.exists() else []
+        if len(done) >= 2:
+            outer = [r for r in _runs(db) if r[1] == "RUNNING"]
+            break
+        time.sleep(0.2)
+    os.kill(proc.pid, signal.SIGKILL)  # no chance to clean up
+    proc.communicate()
+    assert outer, "run did not get going"
+    p = subprocess.run([sys.executable, "-m", "toolkit.cli", "run", f"resume={_outer_id(store_dir)}",
+                        f"store={store_dir}"], env=jt_env(example_plugin_dir), capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert "resumed after" in p.stderr
+    from toolkit.store.tracking import Store
+
+    store = Store(store_dir)
+    rid = _outer_id(store_dir)
+    hist = h5.read(store.artifact_dir(rid) / "search_history.h5")
+    assert list(hist["index"]) == list(range(6))
+    # the same points an uninterrupted run would have evaluated
+    ref = run(compose(["task=quadratic", "search=random", "search.budget=6", "executor.workers=1",
+                       f"store={store_dir}", "seed=1"]))
+    np.testing.assert_allclose(hist["x"], np.stack([[e.point["x0"], e.point["x1"]] for e in ref.evaluations]))
+    children = store.client.search_runs([store.get_run(rid).info.experiment_id],
+                                        filter_string=f"tags.mlflow.parentRunId = '{rid}'")
+    statuses = sorted(c.info.status for c in children)
+    assert statuses.count("FINISHED") == 6 and set(statuses) <= {"FINISHED", "KILLED"}
+    assert store.get_run(rid).info.status == "FINISHED"
+
+
+def _outer_id(store_dir):
+    from toolkit.store.tracking import Store
+
+    store = Store(store_dir)
+    exp = store.experiment_id("quadratic")
+    runs = store.client.search_runs([exp], filter_string="tags.`jt.search` = 'random'")
+    return sorted(runs, key=lambda r: r.info.start_time)[0].info.run_id
+
+
+def test_interrupt_marks_run_killed_with_reason(example_plugin_dir, store_dir):
+    args = [sys.executable, "-m", "toolkit.cli", "run", "task=quadratic", "task.sleep=20",
+            "executor.workers=1", f"store={store_dir}"]
+    proc = subprocess.Popen(args, env=jt_env(example_plugin_dir), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    db = store_dir / "mlflow.db"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (db.exists() and _runs(db)):
+        time.sleep(0.2)
+    time.sleep(1.0)
+    # SIGTERM, not SIGINT: a shell that starts jobs in the background makes them ignore SIGINT
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "resume=" in err
+    (rid, status), = _runs(db)
+    assert status == "KILLED"
+    con = sqlite3.connect(db)
+    reason = con.execute("select value from tags where key='jt.reason'").fetchone()[0]
+    assert "sigterm" in reason.lower()
