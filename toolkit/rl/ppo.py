@@ -1,0 +1,416 @@
+"""PPO as used by the athletic-jumping papers (000 §4.1, §6.2; 001 §3.4.1), in one readable file.
+
+Read top to bottom: ``PPOConfig`` (every hyper-parameter, with its source), the exploration-noise
+schedule, GAE(λ)/TD(λ), the clipped-surrogate update, and ``train`` (collect → estimate → update →
+checkpoint). Rollouts are collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either as
+executor actors or in this process; checkpoints are HDF5 files (``toolkit/rl/checkpoint.py``).
+
+Sources cited below: ``000`` = Yin et al. 2021 (the paper), ``001`` = Yang's thesis ch. 3 (the same
+work), ``code`` = the authors' public code (arpspoof/Jump, ``presets/default/...``), consulted where
+the paper is silent. See ``docs/ppo.md`` for the deviations and the sanity benchmark.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+import numpy as np
+import torch
+from torch import nn
+
+from toolkit.rl import checkpoint as ckpt
+from toolkit.rl.networks import ActorCritic, RunningObsStats, gaussian_log_prob
+from toolkit.rl.rollout import merge_batches, start_workers
+
+
+@dataclasses.dataclass
+class PPOConfig:
+    """Every PPO hyper-parameter; defaults are the jumping papers' values."""
+
+    policy_hidden: tuple[int, ...] = (1024, 512)
+    """Policy MLP hidden sizes, ReLU (000 §4.1 "two hidden layers with 1024 and 512 units")."""
+    value_hidden: tuple[int, ...] = (1024, 512)
+    """Value MLP hidden sizes; one linear output unit (000 §4.1 "similar to the policy network")."""
+    std_start: float = 0.5
+    """Fixed (not learned) action std at the start of training (000 §4.1, Σ = σI, σ: 0.5 → 0.1)."""
+    std_end: float = 0.1
+    """Action std after the annealing period (000 §4.1)."""
+    std_anneal_samples: float = 1.0e7
+    """Samples over which σ decreases linearly, then stays at ``std_end`` (000 §4.1 "first 1.0×10^7
+    simulation steps")."""
+    samples_per_iteration: int = 4096
+    """State-action samples collected per iteration (000 §6.2); rounded up to a whole number of
+    steps per environment."""
+    epochs: int = 5
+    """Passes over each batch (000 §6.2 "five policy updates"; code: ``epoch_size: 5``)."""
+    minibatch_size: int = 256
+    """Minibatch size (000 §6.2)."""
+    clip: float = 0.02
+    """PPO ratio clip threshold ε (000 §6.2)."""
+    policy_lr: float = 2.5e-5
+    """Policy learning rate (000 §6.2)."""
+    value_lr: float = 1.0e-2
+    """Value learning rate (000 §6.2)."""
+    optimizer: str = "sgd"
+    """``sgd`` (with momentum) or ``adam``; separate optimisers for policy and value. The paper does
+    not name it; the authors' code uses SGD with momentum (code ``ppo.yaml``), as DeepMimic does."""
+    momentum: float = 0.9
+    """SGD momentum (code ``actor_momentum``/``critic_momentum: 0.9``; paper silent)."""
+    weight_decay: float = 5.0e-4
+    """L2 weight decay of both optimisers (code ``actor_wdecay``/``critic_wdecay``; paper silent)."""
+    max_grad_norm: float = 100.0
+    """Gradient-norm clip per network; 0 disables (code ``max_grad_norm: 100``; paper silent)."""
+    gamma: float = 1.0
+    """Discount factor (000 §6.2 "short horizon and sparse rewards")."""
+    lam: float = 0.95
+    """λ of both TD(λ) value targets and GAE(λ) advantages (000 §6.2)."""
+    norm_adv: bool = True
+    """Standardise advantages over each batch (code; paper silent)."""
+    adv_clip: float = 4.0
+    """Clip standardised advantages to ±this; 0 disables (code; paper silent)."""
+    obs_norm: bool = True
+    """Running mean/std observation normalisation (DeepMimic lineage; code ``Normalizer``)."""
+    obs_norm_max_samples: int = 1_000_000
+    """Samples after which the normaliser's statistics freeze (code ``sample_lim``)."""
+    normalize_actions: bool = False
+    """False: the policy acts in the env's units and actions are clipped to its Box (as in the
+    code, where σ is in raw action units); True: ``[-1, 1]`` mapped affinely onto the Box."""
+    reward_scale: float = 1.0
+    """Rewards are multiplied by this for learning only (reported returns stay raw); jt default 1."""
+    reset_each_iteration: bool = True
+    """Start new seeded episodes at every iteration (cut episodes are bootstrapped like time
+    limits). Makes a resumed run bit-identical to an uninterrupted one; False lets episodes run on
+    across iterations (a resume then restarts episodes). jt choice, see docs/ppo.md."""
+    total_samples: int = 100_000_000
+    """Training budget in samples (not stated in 000; tasks set their own)."""
+    checkpoint_every: int = 100
+    """Iterations between checkpoints (code ``checkpoint_every_iteration: 100``); also at the end."""
+    seed: int = 0
+    """Run seed: network init, minibatch order, every environment and action-noise seed."""
+    n_workers: int = 1
+    """Rollout workers (executor actors). With ``envs_per_worker`` it fixes the seed layout, so
+    results do not depend on the executor."""
+    envs_per_worker: int = 16
+    """Environments per worker, stepped in lock-step (16 → 256 steps each per iteration)."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able dict (tuples become lists)."""
+        return json.loads(json.dumps(dataclasses.asdict(self)))
+
+
+class IterationStats(dict):
+    """The scalar stats of one iteration (``{name: float}``), plus ``episodes``: one dict per
+    episode finished in it (``return``, ``length``, ``terminated`` and the numeric scalars of its
+    last ``info``), kept as an attribute so that ``items()`` yields only floats."""
+
+    def __init__(self, scalars: dict[str, float], episodes: list[dict[str, float]]) -> None:
+        super().__init__(scalars)
+        self.episodes = episodes
+
+
+@dataclasses.dataclass
+class TrainResult:
+    """What ``train`` returns.
+
+    Attributes:
+        model: the trained actor-critic (policy mean, value, observation normaliser).
+        iterations: iterations done (including those before a resume).
+        samples: samples collected.
+        history: per-iteration scalar stats ``{name: [value per iteration]}``.
+        extra: the caller's ``extra`` dict (restored from the checkpoint on resume).
+        checkpoint_path: the last checkpoint written, if any.
+    """
+
+    model: ActorCritic
+    iterations: int
+    samples: int
+    history: dict[str, list[float]]
+    extra: dict[str, Any]
+    checkpoint_path: Optional[Path] = None
+
+
+def action_std(samples: float, cfg: PPOConfig) -> float:
+    """σ after ``samples`` samples: linear from ``std_start`` to ``std_end`` (000 §4.1)."""
+    if cfg.std_anneal_samples <= 0:
+        return float(cfg.std_end)
+    frac = min(max(samples / cfg.std_anneal_samples, 0.0), 1.0)
+    return float(cfg.std_start + frac * (cfg.std_end - cfg.std_start))
+
+
+def compute_gae(
+    rewards: np.ndarray,
+    values: np.ndarray,
+    next_values: np.ndarray,
+    terminated: np.ndarray,
+    truncated: np.ndarray,
+    gamma: float,
+    lam: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """GAE(λ) advantages and TD(λ) value targets (λ-returns), time-limit aware.
+
+    ``δ_t = r_t + γ (1 - terminated_t) V'_t - V(s_t)``, ``A_t = δ_t + γλ (1 - done_t) A_{t+1}``,
+    ``target_t = A_t + V(s_t)``, where ``V'_t`` is ``next_values[t]`` (the value of the state
+    reached, the final observation's on a truncation) and ``done = terminated | truncated``. The
+    last row is bootstrapped from ``next_values[-1]``.
+
+    Args:
+        rewards, values, next_values: ``(n_steps, n_envs)``.
+        terminated, truncated: ``(n_steps, n_envs)`` bool.
+        gamma: discount.
+        lam: λ.
+
+    Returns:
+        ``(advantages, targets)``, both ``(n_steps, n_envs)`` float64.
+    """
+    not_term = 1.0 - np.asarray(terminated, dtype=np.float64)
+    not_done = not_term * (1.0 - np.asarray(truncated, dtype=np.float64))
+    values = np.asarray(values, dtype=np.float64)
+    delta = rewards + gamma * not_term * np.asarray(next_values, dtype=np.float64) - values
+    adv = np.zeros_like(delta)
+    running = np.zeros(delta.shape[1:])
+    for t in reversed(range(delta.shape[0])):
+        running = delta[t] + gamma * lam * not_done[t] * running
+        adv[t] = running
+    return adv, adv + values
+
+
+def _make_optimizer(params: Any, lr: float, cfg: PPOConfig) -> torch.optim.Optimizer:
+    if cfg.optimizer == "sgd":
+        return torch.optim.SGD(params, lr=lr, momentum=cfg.momentum, weight_decay=cfg.weight_decay)
+    if cfg.optimizer == "adam":
+        return torch.optim.Adam(params, lr=lr, weight_decay=cfg.weight_decay)
+    raise ValueError(f"unknown optimizer {cfg.optimizer!r} (sgd or adam)")
+
+
+def ppo_update(
+    model: ActorCritic,
+    pi_opt: torch.optim.Optimizer,
+    v_opt: torch.optim.Optimizer,
+    batch: dict[str, np.ndarray],
+    std: float,
+    cfg: PPOConfig,
+    rng: np.random.Generator,
+) -> dict[str, float]:
+    """``cfg.epochs`` passes of clipped-surrogate policy and MSE value steps over a flat batch.
+
+    Args:
+        batch: ``obs`` ``(n, obs_dim)``, ``actions`` ``(n, act_dim)``, ``logp``, ``adv``,
+            ``targets`` ``(n,)``.
+        std: the σ the batch was collected with.
+        rng: draws the minibatch permutations.
+
+    Returns:
+        Mean policy loss, value loss, clip fraction and approximate KL over all minibatches.
+    """
+    obs = torch.as_tensor(batch["obs"], dtype=torch.float32)
+    act = torch.as_tensor(batch["actions"], dtype=torch.float32)
+    old_logp = torch.as_tensor(batch["logp"], dtype=torch.float32)
+    adv = np.asarray(batch["adv"], dtype=np.float64)
+    if cfg.norm_adv:
+        adv = (adv - adv.mean()) / (adv.std() + 1e-5)
+    if cfg.adv_clip > 0:
+        adv = np.clip(adv, -cfg.adv_clip, cfg.adv_clip)
+    adv_t = torch.as_tensor(adv, dtype=torch.float32)
+    targets = torch.as_tensor(batch["targets"], dtype=torch.float32)
+    n = obs.shape[0]
+    sums = {"policy_loss": 0.0, "value_loss": 0.0, "clip_frac": 0.0, "approx_kl": 0.0}
+    n_mb = 0
+    for _ in range(cfg.epochs):
+        perm = torch.from_numpy(rng.permutation(n))
+        for start in range(0, n, cfg.minibatch_size):
+            idx = perm[start:start + cfg.minibatch_size]
+            x = model.norm(obs[idx])
+            # policy: clipped surrogate (Schulman et al. 2017)
+            logp = gaussian_log_prob(model.pi(x), std, act[idx])
+            log_ratio = logp - old_logp[idx]
+            ratio = log_ratio.exp()
+            a = adv_t[idx]
+            surr = torch.min(ratio * a, ratio.clamp(1.0 - cfg.clip, 1.0 + cfg.clip) * a)
+            pi_loss = -surr.mean()
+            pi_opt.zero_grad()
+            pi_loss.backward()
+            if cfg.max_grad_norm > 0:
+                nn.utils.clip_grad_norm_(model.pi.parameters(), cfg.max_grad_norm)
+            pi_opt.step()
+            # value: regression onto the TD(λ) targets
+            v_loss = ((model.v(x).squeeze(-1) - targets[idx]) ** 2).mean()
+            v_opt.zero_grad()
+            v_loss.backward()
+            if cfg.max_grad_norm > 0:
+                nn.utils.clip_grad_norm_(model.v.parameters(), cfg.max_grad_norm)
+            v_opt.step()
+            with torch.no_grad():
+                sums["policy_loss"] += float(pi_loss)
+                sums["value_loss"] += float(v_loss)
+                sums["clip_frac"] += float(((ratio - 1.0).abs() > cfg.clip).float().mean())
+                sums["approx_kl"] += float(((ratio - 1.0) - log_ratio).mean())
+            n_mb += 1
+    return {k: v / max(n_mb, 1) for k, v in sums.items()}
+
+
+def _probe(env_fn: Callable[[int], Any], seed: int) -> tuple[int, int, np.ndarray, np.ndarray]:
+    import gymnasium
+
+    env = env_fn(seed)
+    try:
+        space = env.action_space
+        if not isinstance(space, gymnasium.spaces.Box):
+            raise TypeError(f"PPO needs a continuous Box action space, got {space}")
+        return (int(np.prod(env.observation_space.shape)), int(np.prod(space.shape)),
+                np.asarray(space.low, np.float64).reshape(-1), np.asarray(space.high, np.float64).reshape(-1))
+    finally:
+        env.close()
+
+
+def train(
+    env_fn: Callable[[int], Any],
+    cfg: PPOConfig,
+    executor: Any = None,
+    checkpoint_path: str | Path | None = None,
+    resume: bool = True,
+    on_iteration: Optional[Callable[[int, int, dict[str, Any]], Optional[dict[str, Any]]]] = None,
+    extra: Optional[dict[str, Any]] = None,
+) -> TrainResult:
+    """Train a policy with PPO until ``cfg.total_samples`` samples have been collected.
+
+    Args:
+        env_fn: picklable ``env_fn(seed) -> gymnasium.Env`` (continuous Box actions).
+        cfg: hyper-parameters.
+        executor: a ``jt.executors`` plugin; its ``actors`` hold the rollout workers. None (or
+            ``cfg.n_workers == 1``) runs them in this process, with identical results.
+        checkpoint_path: HDF5 checkpoint written every ``cfg.checkpoint_every`` iterations and at
+            the end.
+        resume: continue from ``checkpoint_path`` if it exists.
+        on_iteration: ``on_iteration(iteration, samples, stats)`` after each iteration (1-based
+            count of iterations done, total samples). ``stats`` is an ``IterationStats``: a dict of
+            floats (``mean_return``, ``mean_length``, ``n_episodes``, ``mean_reward``,
+            ``policy_loss``, ``value_loss``, ``clip_frac``, ``approx_kl``, ``explained_variance``,
+            ``action_std``, ``samples_per_s``, ``collect_s``, ``update_s``) whose ``.episodes``
+            lists the episodes finished in this iteration. It may return
+            a dict of attributes to set on every environment before the next iteration (e.g. a
+            curriculum's bar height); those are checkpointed and re-applied on resume.
+        extra: caller state saved in every checkpoint's ``extra`` group and, on resume, replaced in
+            place by the saved one (e.g. a curriculum's state).
+
+    Returns:
+        The trained model, counters, history and ``extra``.
+    """
+    extra = {} if extra is None else extra
+    obs_dim, act_dim, low, high = _probe(env_fn, cfg.seed)
+    torch.manual_seed(cfg.seed)
+    model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high,
+                        cfg.normalize_actions)
+    pi_opt = _make_optimizer(model.pi.parameters(), cfg.policy_lr, cfg)
+    v_opt = _make_optimizer(model.v.parameters(), cfg.value_lr, cfg)
+    obs_stats = RunningObsStats(obs_dim, cfg.obs_norm_max_samples)
+    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([cfg.seed, 3])))
+    iteration, samples = 0, 0
+    history: dict[str, list[float]] = {}
+    env_attrs: dict[str, Any] = {}
+    path = Path(checkpoint_path) if checkpoint_path is not None else None
+
+    if path is not None and resume and path.exists():
+        groups, _ = ckpt.load(path)
+        model.pi.load_state_dict(groups["policy"])
+        model.v.load_state_dict(groups["value"])
+        norm = groups["obs_norm"]
+        model.norm.load_state_dict({"mean": torch.as_tensor(norm["mean"]),
+                                    "std": torch.as_tensor(norm["std"])})
+        obs_stats.load_state(norm)
+        pi_opt.load_state_dict(groups["policy_optim"])
+        v_opt.load_state_dict(groups["value_optim"])
+        iteration, samples = groups["counters"]["iteration"], groups["counters"]["samples"]
+        rng.bit_generator.state = json.loads(groups["rng"]["numpy"])
+        torch.set_rng_state(groups["rng"]["torch"])
+        history = {k: [float(x) for x in v] for k, v in groups["history"].items()}
+        env_attrs = groups["env_attrs"]
+        extra.clear()
+        extra.update(groups["extra"])
+
+    n_envs = cfg.n_workers * cfg.envs_per_worker
+    n_steps = math.ceil(cfg.samples_per_iteration / n_envs)
+    workers = start_workers(env_fn, cfg.seed, cfg.n_workers, cfg.envs_per_worker,
+                            cfg.policy_hidden, cfg.value_hidden, cfg.normalize_actions,
+                            cfg.reset_each_iteration, executor)
+
+    def save() -> Path:
+        assert path is not None
+        mean, std = model.norm.mean.numpy(), model.norm.std.numpy()
+        return ckpt.save(path, {
+            "policy": model.pi.state_dict(), "value": model.v.state_dict(),
+            "obs_norm": {"mean": mean, "std": std, **obs_stats.state()},
+            "policy_optim": pi_opt.state_dict(), "value_optim": v_opt.state_dict(),
+            "counters": {"iteration": iteration, "samples": samples},
+            "rng": {"numpy": json.dumps(rng.bit_generator.state), "torch": torch.get_rng_state(),
+                    "seed": cfg.seed, "env_ids": np.arange(n_envs), "seed_offset": iteration},
+            "history": {k: np.asarray(v, dtype=np.float64) for k, v in history.items()},
+            "env_attrs": env_attrs, "extra": extra,
+        }, {"config": cfg.to_dict(), "obs_dim": obs_dim, "act_dim": act_dim,
+            "low": low, "high": high})
+
+    saved: Optional[Path] = None
+    try:
+        if env_attrs:
+            workers.call("set_env_attrs", [(env_attrs,)] * workers.size)
+        while samples < cfg.total_samples:
+            # 1. collect: every worker steps its envs n_steps times with the current weights
+            t0 = time.perf_counter()
+            std = action_std(samples, cfg)
+            weights = model.numpy_state()
+            workers.call("set_weights", [(weights,)] * workers.size)
+            batch = merge_batches(workers.call("collect", [(n_steps, std, iteration)] * workers.size))
+            t1 = time.perf_counter()
+            # 2. advantages GAE(λ) and value targets TD(λ)
+            adv, targets = compute_gae(batch["rewards"] * cfg.reward_scale, batch["values"],
+                                       batch["next_values"], batch["terminated"],
+                                       batch["truncated"], cfg.gamma, cfg.lam)
+            flat = {"obs": batch["obs"].reshape(-1, obs_dim),
+                    "actions": batch["actions"].reshape(-1, act_dim),
+                    "logp": batch["logp"].reshape(-1), "adv": adv.reshape(-1),
+                    "targets": targets.reshape(-1)}
+            # 3. update policy and value, then the observation normaliser (used from next batch)
+            losses = ppo_update(model, pi_opt, v_opt, flat, std, cfg, rng)
+            if cfg.obs_norm:
+                obs_stats.update(flat["obs"])
+                mean, sd = obs_stats.mean_std()
+                model.norm.mean.copy_(torch.as_tensor(mean, dtype=torch.float32))
+                model.norm.std.copy_(torch.as_tensor(sd, dtype=torch.float32))
+            t2 = time.perf_counter()
+            iteration += 1
+            n_batch = flat["obs"].shape[0]
+            samples += n_batch
+            # 4. statistics, caller hook, checkpoint
+            eps = batch["episodes"]
+            resid = flat["targets"] - batch["values"].reshape(-1)
+            var_t = float(np.var(flat["targets"]))
+            stats: dict[str, float] = {
+                "mean_return": float(np.mean([e["return"] for e in eps])) if eps else float("nan"),
+                "mean_length": float(np.mean([e["length"] for e in eps])) if eps else float("nan"),
+                "n_episodes": float(len(eps)),
+                "mean_reward": float(batch["rewards"].mean()),
+                **losses,
+                "explained_variance": 1.0 - float(np.var(resid)) / var_t if var_t > 0 else float("nan"),
+                "action_std": std,
+                "samples_per_s": n_batch / (t2 - t0),
+                "collect_s": t1 - t0,
+                "update_s": t2 - t1,
+            }
+            for k, v in stats.items():
+                history.setdefault(k, []).append(float(v))
+            if on_iteration is not None:
+                attrs = on_iteration(iteration, samples, IterationStats(stats, eps))
+                if attrs:
+                    env_attrs.update(attrs)
+                    workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)
+            if path is not None and iteration % max(cfg.checkpoint_every, 1) == 0:
+                saved = save()
+        if path is not None:
+            saved = save()
+    finally:
+        workers.close()
+    return TrainResult(model, iteration, samples, history, extra, saved)
