@@ -9,8 +9,9 @@ from typing import Optional
 
 import typer
 
-from toolkit.cli import bench_app
 from toolkit.errors import JtError
+
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks (speed is measured here, never in tests).")
 
 MODELS = ("humanoid", "laikago", "atlas", "snake36", "snake72", "snake195")
 BACKENDS = ("df", "sf", "pcg", "maba", "bullet")

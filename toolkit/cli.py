@@ -17,7 +17,9 @@ app = typer.Typer(
     help="jt: discover and learn motion strategies for simulated characters.",
     context_settings={"help_option_names": ["-h", "--help"]},
 )
-bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks (speed is measured here, never in tests).")
+
+from toolkit.bench_cli import bench_app  # noqa: E402  (light: typer only)
+
 app.add_typer(bench_app, name="bench")
 
 _DEBUG = {"on": False}
@@ -165,8 +167,6 @@ def main() -> None:
     """Console entry point: one line for user mistakes, exit status 2."""
     debug = "--debug" in sys.argv
     try:
-        from toolkit import bench_cli  # noqa: F401  (registers `jt bench ...`; light module)
-
         rc = app(standalone_mode=False)
         if isinstance(rc, int) and rc:  # typer turns Ctrl-C into exit code 130 and returns it
             if rc == 130:

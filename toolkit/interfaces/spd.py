@@ -14,11 +14,14 @@ if TYPE_CHECKING:  # pragma: no cover
 class SPDBackend(Plugin, abc.ABC):
     """Computes Stable PD torques (thesis ``001`` eq 2.4/2.6) at the current state.
 
-    Generalised coordinates follow ``toolkit.dynamics``: for a floating base, ``q`` is root
-    position (3), root orientation quaternion x,y,z,w (4), then the joints in model order
-    (spherical joints as x,y,z,w quaternions, revolute/prismatic as one scalar); ``qd`` has the
-    root linear and angular velocity (6, world frame, as PyBullet reports them) then one entry
-    per joint DoF (3 for a spherical joint, local angular velocity).
+    Generalised coordinates follow ``toolkit.dynamics`` (= PyBullet's ``getBase*`` and
+    ``getJointStatesMultiDof``): for a floating base, ``q`` is root position (3), root orientation
+    quaternion x,y,z,w (4) -- of PyBullet's base frame, i.e. the base link's inertial frame --
+    then the joints in model order (spherical joints as x,y,z,w quaternions, revolute/prismatic
+    as one scalar); ``qd`` has the root linear and angular velocity (6, world frame, as PyBullet
+    reports them) then one entry per joint DoF (3 for a spherical joint, angular velocity in the
+    child link's frame). Generalised forces use the ``qd`` layout (root: world force at the base
+    frame origin, then world torque).
 
     Args:
         cfg: the ``spd`` config group, validated against ``Config``.

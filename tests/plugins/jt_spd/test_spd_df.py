@@ -1,0 +1,11 @@
+"""``spd=df``: the shared SPD backend suite."""
+
+from __future__ import annotations
+
+from spd_backend_suite import SPDBackendSuite
+
+from jt_spd.df import DenseBackend
+
+
+class TestDenseBackend(SPDBackendSuite):
+    backend_cls = DenseBackend

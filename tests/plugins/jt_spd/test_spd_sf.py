@@ -1,0 +1,11 @@
+"""``spd=sf``: the shared SPD backend suite."""
+
+from __future__ import annotations
+
+from spd_backend_suite import SPDBackendSuite
+
+from jt_spd.sf import SparseBackend
+
+
+class TestSparseBackend(SPDBackendSuite):
+    backend_cls = SparseBackend

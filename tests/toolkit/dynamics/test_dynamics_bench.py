@@ -1,0 +1,23 @@
+"""Benchmark functions run end to end on a tiny budget (speed is measured by them, not here)."""
+
+from __future__ import annotations
+
+import math
+
+
+def test_time_spd_rows_and_summary():
+    from toolkit.dynamics.bench import BACKENDS, format_table, summarize, time_spd
+
+    rows = time_spd(["humanoid", "snake195"], backends=BACKENDS, n_samples=3, seed=0)
+    assert len(rows) == 2 * len(BACKENDS)
+    keys = {"model", "dof", "depth", "backend", "solve_us_median", "step_us_median"}
+    assert all(set(r) == keys for r in rows)
+    by = {(r["model"], r["backend"]): r for r in rows}
+    assert by[("humanoid", "maba")]["dof"] == 34 and by[("snake195", "maba")]["depth"] == 195
+    assert math.isnan(by[("humanoid", "bullet")]["solve_us_median"])  # inside PyBullet's step
+    assert by[("humanoid", "bullet")]["step_us_median"] > 0
+    assert math.isnan(by[("snake195", "maba")]["step_us_median"])  # beyond PyBullet's API
+    assert all(by[("snake195", b)]["solve_us_median"] > 0 for b in ("maba", "df", "sf", "pcg"))
+    s = summarize(rows)
+    assert s["df_over_maba_solve_195"] > 0 and math.isnan(s["maba_solve_growth_36_to_195"])
+    assert "humanoid" in format_table(rows)
