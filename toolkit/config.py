@@ -93,11 +93,12 @@ def _check_choices(parsed: Sequence[Any]) -> None:
         if not isinstance(value, str):
             continue
         if key in plugins.KINDS:
-            choices = plugins.names(key)
-            if value not in choices:
+            # a kind's group holds plugin configs (name: <plugin>) and may hold other option
+            # files (e.g. reward/highjump.yaml, a set of terms); the validator checks `name:` later
+            options = group_options(key)
+            if value not in options:
+                choices = sorted(set(options) | set(plugins.names(key)))
                 raise plugins.UnknownPlugin(key, value, choices)
-            if value not in group_options(key):
-                raise JtError(f"{key} plugin '{value}' ships no config {key}/{value}.yaml")
         else:
             opts = group_options(key)
             if opts and value not in opts:

@@ -275,6 +275,7 @@ def train(
     resume: bool = True,
     on_iteration: Optional[Callable[[int, int, dict[str, Any]], Optional[dict[str, Any]]]] = None,
     extra: Optional[dict[str, Any]] = None,
+    should_stop: Optional[Callable[[], bool]] = None,
 ) -> TrainResult:
     """Train a policy with PPO until ``cfg.total_samples`` samples have been collected.
 
@@ -296,6 +297,8 @@ def train(
             curriculum's bar height); those are checkpointed and re-applied on resume.
         extra: caller state saved in every checkpoint's ``extra`` group and, on resume, replaced in
             place by the saved one (e.g. a curriculum's state).
+        should_stop: checked after every iteration; training ends early (with a final checkpoint)
+            when it returns True, e.g. once a curriculum reaches ``z_freeze``.
 
     Returns:
         The trained model, counters, history and ``extra``.
@@ -409,6 +412,8 @@ def train(
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)
             if path is not None and iteration % max(cfg.checkpoint_every, 1) == 0:
                 saved = save()
+            if should_stop is not None and should_stop():
+                break
         if path is not None:
             saved = save()
     finally:

@@ -1,0 +1,125 @@
+"""Shared plumbing of jt's curricula: config parsing and the PPO ``on_iteration`` glue."""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import math
+from typing import Any, Optional
+
+from toolkit.errors import JtError
+from toolkit.interfaces.curriculum import Curriculum
+
+
+def config_of(config_cls: type, cfg: Any, what: str = "curriculum") -> Any:
+    """A typed ``Config`` from ``None``, an instance, a dataclass, a dict or a group node.
+
+    Raises:
+        JtError: an unknown key (the valid ones are listed) or a value of the wrong type.
+    """
+    if cfg is None:
+        return config_cls()
+    if isinstance(cfg, config_cls):
+        return cfg
+    from omegaconf import OmegaConf
+
+    if dataclasses.is_dataclass(cfg):
+        params = dataclasses.asdict(cfg)
+    elif isinstance(cfg, dict):
+        params = dict(cfg)
+    else:
+        params = OmegaConf.to_container(cfg, resolve=True)
+    known = {f.name for f in dataclasses.fields(config_cls)}
+    if "name" not in known:
+        params.pop("name", None)
+    unknown = sorted(set(params) - known)
+    if unknown:
+        valid = ", ".join(sorted(known - {"name"}))
+        raise JtError(f"{what}: unknown key(s) {', '.join(unknown)} (valid keys: {valid})")
+    try:
+        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(config_cls), params))
+    except Exception as e:  # noqa: BLE001 - OmegaConf raises several validation types
+        msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        key = getattr(e, "full_key", None)
+        raise JtError(f"{what}: {key + ': ' if key else ''}{msg}") from e
+
+
+def finite_or(value: Any, default: float = 0.0) -> float:
+    """``float(value)``, or ``default`` for None / NaN / inf (e.g. an iteration with no episode)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return default
+    return v if math.isfinite(v) else default
+
+
+class IterationCurriculum(Curriculum):
+    """A curriculum driven by the PPO trainer's ``on_iteration`` hook.
+
+    Use::
+
+        cur = load("curriculum", name)(cfg.curriculum)
+        extra = cur.bind({})                     # the dict given to ppo.train(extra=...)
+        env_fn = make_env_fn(**cur.env_attrs())  # the first iteration's difficulty
+        ppo.train(env_fn, ..., on_iteration=cur.on_iteration, extra=extra)
+
+    ``on_iteration`` feeds every finished episode to ``update``, the iteration's scalar stats to
+    ``end_iteration``, stores ``state()`` in ``extra`` (checkpointed by the trainer) and returns
+    ``env_attrs()`` for the trainer to set on every environment. On resume the trainer replaces
+    ``extra`` in place with the checkpoint's; the first ``on_iteration`` call then loads it.
+
+    Args:
+        cfg: the ``curriculum`` config group.
+    """
+
+    #: key of this curriculum's state inside the trainer's ``extra`` dict
+    extra_key = "curriculum"
+
+    def __init__(self, cfg: Any = None) -> None:
+        super().__init__(cfg)
+        self.params = config_of(type(self).Config, cfg, f"curriculum={type(self).name or type(self).__name__}")
+        self._extra: Optional[dict[str, Any]] = None
+        self._synced = False
+
+    @abc.abstractmethod
+    def end_iteration(self, iteration: int, samples: int, stats: Any) -> None:
+        """Account for one finished training iteration (after its episodes went to ``update``).
+
+        Args:
+            iteration: iterations done so far (1-based).
+            samples: samples collected so far.
+            stats: the trainer's scalar stats of the iteration (``mean_return``, ``mean_reward``...).
+        """
+
+    @abc.abstractmethod
+    def env_attrs(self) -> dict[str, Any]:
+        """Attributes to set on every environment for the current difficulty."""
+
+    def frozen(self) -> bool:
+        """True once training may stop (e.g. ``z_freeze`` reached); never for a plain curriculum."""
+        return False
+
+    def bind(self, extra: dict[str, Any]) -> dict[str, Any]:
+        """Keep this curriculum's state in ``extra[extra_key]`` (the trainer's checkpointed dict).
+
+        Returns:
+            ``extra`` itself, holding the current ``state()`` unless it already holds a saved one.
+        """
+        self._extra = extra
+        self._synced = False
+        extra.setdefault(self.extra_key, dict(self.state()))
+        return extra
+
+    def on_iteration(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
+        """The PPO trainer's hook: update from ``stats`` and return the environments' attributes."""
+        if self._extra is not None and not self._synced:
+            saved = self._extra.get(self.extra_key)
+            if saved:
+                self.load_state(dict(saved))
+            self._synced = True
+        for episode in getattr(stats, "episodes", ()) or ():
+            self.update(episode)
+        self.end_iteration(iteration, samples, stats)
+        if self._extra is not None:
+            self._extra[self.extra_key] = dict(self.state())
+        return self.env_attrs()
