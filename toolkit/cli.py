@@ -50,7 +50,11 @@ def run_cmd(
     from toolkit.execution.runner import run
 
     res = run(conf)
-    shown = ", ".join(f"{k}={v:.4g}" for k, v in list(res.metrics.items())[:8])
+    from toolkit import plugins
+
+    keys = list(getattr(plugins.load("task", str(conf.task.name)), "key_metrics", ()))
+    ordered = [k for k in keys if k in res.metrics] + [k for k in res.metrics if k not in keys]
+    shown = ", ".join(f"{k}={res.metrics[k]:.4g}" for k in ordered[:8])
     typer.echo(f"run {res.run_id} FINISHED  {shown}")
     typer.echo(f"  jt show {res.run_id} store={res.store.root}")
     typer.echo(f"  jt ui store={res.store.root}")

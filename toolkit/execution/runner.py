@@ -182,7 +182,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
     obj_names = list(problem.objective_names)
     while not searcher.finished() and len(history) < budget:
         x = np.asarray(searcher.ask(min(int(cfg.search.batch), budget - len(history))), dtype=float)
-        if x.size == 0:
+        if len(x) == 0:  # a task with no parameters still has one (empty) point
             break
         b, start = history.n_batches, len(history)
         jobs, child_ids = [], []
@@ -243,6 +243,9 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
                 metrics[f"best_{key}"] = float(max(vals))
     with store.metrics(run_id) as buf:
         buf.add_many(metrics)
+    if not nested:  # the evaluations were logged on this run: report their metrics as the run's
+        for e in evs:
+            metrics = {**{k: float(v) for k, v in e.metrics.items()}, **metrics}
     h5.write(out_dir / "search.h5", {"history": history.arrays(), "searcher": searcher.summary() or {}},
              attrs={"format": "jt.search/1"})
     history.save(hist_path)

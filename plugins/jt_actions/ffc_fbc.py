@@ -1,0 +1,123 @@
+"""``action=ffc_fbc``: feed-forward reference pose plus the policy's feedback correction (``002`` §4.2).
+
+``002`` Fig. 4: the feed-forward controller (FFC) "stores the joint angles from the reference and
+linearly interpolates them at run time according to the current phase index φ to generate q̂";
+the feedback controller (the policy network) outputs corrections Δq; the PD target is
+``q = q̂ + Δq``, "all angles ... parameterized in exponential maps". The reference's exp maps are
+unwrapped along the clip (each frame takes the representative ``v + 2πn v̂`` nearest the previous
+frame's) so that linear interpolation never crosses the ``|v| = π`` seam.
+
+The phase ``φ ∈ [0, 1]`` comes from ``obs["phase"]`` / ``obs.phase`` / a bare number passed as
+``obs``, or from ``set_phase``; a looping clip wraps φ, a non-looping one clamps it. ``reset(state)``
+sets φ to ``state`` (a number) or 0. There is no naturalness term (``penalty() == 1``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from numbers import Real
+from typing import Any
+
+import numpy as np
+
+from jt_actions.base import DofActionSpace, obs_value
+from toolkit.errors import JtError
+
+
+def resolve_clip(name: str) -> str:
+    """Path of a clip given as a path or a name in ``pybullet_data``'s motions (``walk``,
+    ``humanoid3d_walk``, ``laikago_walk``)."""
+    from toolkit.motion.skeletons import motions_dir
+
+    d = motions_dir()
+    for cand in (name, f"{name}.txt", os.path.join(d, name), os.path.join(d, f"{name}.txt"),
+                 os.path.join(d, f"humanoid3d_{name}.txt")):  # fmt: skip
+        if os.path.isfile(cand):
+            return cand
+    known = sorted(f[:-4].replace("humanoid3d_", "") for f in os.listdir(d) if f.endswith(".txt"))
+    raise JtError(f"action=ffc_fbc: no clip '{name}'; give a path or one of: {', '.join(known)}")
+
+
+def unwrap_expmaps(v: np.ndarray) -> np.ndarray:
+    """Exp maps ``(n, 3)`` made continuous along the first axis (same rotations)."""
+    out = np.array(v, dtype=np.float64, copy=True)
+    for k in range(1, len(out)):
+        theta = np.linalg.norm(out[k])
+        if theta < 1e-9:
+            continue
+        axis = out[k] / theta
+        cands = out[k][None, :] + 2.0 * np.pi * np.arange(-2, 3)[:, None] * axis[None, :]
+        out[k] = cands[np.argmin(np.linalg.norm(cands - out[k - 1], axis=1))]
+    return out
+
+
+class FFCFBCActionSpace(DofActionSpace):
+    """Target = reference pose at the phase (feed-forward) + the policy's correction (002 §4.2)."""
+
+    @dataclasses.dataclass
+    class Config:
+        name: str = "ffc_fbc"
+        clip: str = "walk"  # reference clip: a name in pybullet_data's motions (walk, run, backflip, ...) or a path
+        correction_bound: float = 1.0  # ours: bound of each correction Δq (rad); 002 gives none
+        clip_to_limits: bool = True  # keep targets within the joint limits (toolkit.priors.limits)
+
+    def __init__(self, cfg: Any = None, character: Any = None) -> None:
+        super().__init__(cfg, character)
+        from toolkit.motion.clips import load_clip
+
+        clip = load_clip(resolve_clip(self.params.clip))
+        if clip.skeleton.name != self.skeleton.name:
+            raise JtError(f"action=ffc_fbc: clip '{self.params.clip}' is for the {clip.skeleton.name}, "
+                          f"the character is the {self.skeleton.name}")  # fmt: skip
+        self.clip = clip
+        dofs = self.skeleton.joints_to_dofs(clip.joints)
+        for j, s in zip(self.skeleton.joints, self.skeleton.dof_slices.values()):
+            if j.kind == "spherical":
+                dofs[:, s] = unwrap_expmaps(dofs[:, s])
+        self._times = np.asarray(clip.times, dtype=np.float64)
+        self._dofs = dofs
+        self._phase = 0.0
+
+    @property
+    def dim(self) -> int:
+        return self.n_dof
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        high = np.full(self.n_dof, float(self.params.correction_bound))
+        return -high, high
+
+    # ---- phase ---------------------------------------------------------------------------------
+    def set_phase(self, phase: float) -> None:
+        """Current phase φ of the reference (wrapped for a looping clip, else clamped to [0, 1])."""
+        phi = float(phase)
+        if not np.isfinite(phi):
+            raise ValueError(f"phase must be finite, got {phase}")
+        if self.clip.loop and phi != 1.0:
+            phi = phi % 1.0
+        self._phase = float(np.clip(phi, 0.0, 1.0))
+
+    @property
+    def phase(self) -> float:
+        return self._phase
+
+    def reference(self, phase: float | None = None) -> np.ndarray:
+        """The FFC output q̂ ``(n_dof,)``: the clip's dofs linearly interpolated at ``phase``."""
+        if phase is not None:
+            self.set_phase(phase)
+        times = self._times
+        t = self._phase * float(times[-1])
+        i = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
+        w = float(np.clip((t - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0))
+        return (1.0 - w) * self._dofs[i] + w * self._dofs[i + 1]
+
+    # ---- control -------------------------------------------------------------------------------
+    def targets(self, action: np.ndarray, obs: Any = None) -> np.ndarray:
+        phase = obs if isinstance(obs, Real) else obs_value(obs, "phase")
+        if phase is not None:
+            self.set_phase(float(phase))
+        return self.finish(self.reference() + self.check_action(action))
+
+    def reset(self, state: Any = None) -> None:
+        """New episode: φ = ``state`` (a number) or 0."""
+        self.set_phase(float(state) if state is not None else 0.0)

@@ -1,0 +1,74 @@
+"""action=ffc_fbc: the reference pose at the phase plus a correction (002 §4.2, Fig. 4)."""
+
+import numpy as np
+import pytest
+
+from action_contract import ActionSpaceContract
+from jt_actions.ffc_fbc import FFCFBCActionSpace, unwrap_expmaps
+from toolkit.errors import JtError
+from toolkit.motion import HUMANOID
+from toolkit.motion import rotations as rot
+
+
+def _angles(space, dofs_a, dofs_b):
+    """Per-joint rotation differences (rad) between two dof rows."""
+    qa, qb = HUMANOID.dofs_to_joints(dofs_a), HUMANOID.dofs_to_joints(dofs_b)
+    out = []
+    for j, s in zip(HUMANOID.joints, HUMANOID.q_slices.values()):
+        out.append(rot.quat_angle(qa[s], qb[s]) if j.kind == "spherical" else abs(qa[s.start] - qb[s.start]))
+    return np.array(out)
+
+
+class TestFFCFBC(ActionSpaceContract):
+    def make(self):
+        return FFCFBCActionSpace({"name": "ffc_fbc", "clip": "walk"})
+
+    def obs(self, step):
+        return {"phase": 0.13 * step}
+
+    @pytest.mark.parametrize("clip, tol", [("walk", 0.01), ("backflip", 0.05)])
+    def test_zero_correction_reproduces_the_clip(self, clip, tol):
+        space = FFCFBCActionSpace({"clip": clip, "clip_to_limits": False})
+        c = space.clip
+        for k in (0, 1, c.n_frames // 2, c.n_frames - 1):  # at frames: the clip's pose exactly
+            phi = c.times[k] / c.duration
+            got = space.targets(np.zeros(28), {"phase": phi})
+            assert _angles(space, got, HUMANOID.joints_to_dofs(c.joints[k])).max() < 1e-9
+        for phi in np.linspace(0.01, 0.99, 23):  # between frames: linear in exp maps (~ slerp)
+            _, _, joints = c.sample_phase(phi)
+            got = space.targets(np.zeros(28), phi)
+            assert _angles(space, got, HUMANOID.joints_to_dofs(joints)).max() < tol
+            k = np.searchsorted(c.times, phi * c.duration) - 1
+            w = (phi * c.duration - c.times[k]) / (c.times[k + 1] - c.times[k])
+            a, b = HUMANOID.joints_to_dofs(c.joints[k]), HUMANOID.joints_to_dofs(c.joints[k + 1])
+            if np.abs(b - a).max() < 1.0:  # no exp-map seam between these frames
+                np.testing.assert_allclose(got, (1 - w) * a + w * b, atol=1e-9)
+
+    def test_correction_adds_and_phase_sources(self):
+        space = self.make()
+        ref = space.reference(0.25)
+        dq = np.zeros(28)
+        dq[3] = 0.1  # neck exp map x
+        np.testing.assert_allclose(space.targets(dq, {"phase": 0.25}), ref + dq, atol=1e-12)
+        class Obs:
+            phase = 0.25
+        np.testing.assert_allclose(space.targets(np.zeros(28), Obs()), ref, atol=1e-12)
+        space.set_phase(1.25)  # a looping clip wraps
+        assert space.phase == pytest.approx(0.25)
+        space.reset()
+        assert space.phase == 0.0
+        space.reset(0.5)
+        assert space.phase == 0.5
+        assert space.penalty() == 1.0
+
+    def test_unwrap_and_unknown_clip(self):
+        axis = np.array([0.0, 0.0, 1.0])
+        angles = np.linspace(2.8, 3.5, 8)  # crosses pi: the log map flips the axis there
+        raw = rot.quat_to_expmap(rot.quat_from_expmap(angles[:, None] * axis))
+        assert np.abs(np.diff(raw[:, 2])).max() > 5.0
+        np.testing.assert_allclose(unwrap_expmaps(raw)[:, 2], angles, atol=1e-9)
+        with pytest.raises(JtError) as e:
+            FFCFBCActionSpace({"clip": "moonwalk"})
+        assert "walk" in str(e.value)
+        with pytest.raises(JtError):
+            FFCFBCActionSpace({"clip": "laikago_walk"})  # a clip of another character

@@ -1,0 +1,198 @@
+"""Save and load pose priors: one HDF5 file each, found by path or by the MLflow run that made it.
+
+File layout (written atomically with ``toolkit.store.h5.write``)::
+
+    /          attrs: format="jt.pose_prior", version, kind, skeleton, latent_dim,
+                      feature_layout (JSON), condition_names (JSON), info (JSON)
+    /weights/  enc{i}_w, enc{i}_b, mu_w, mu_b, logvar_w, logvar_b, dec{i}_w, dec{i}_b  (float32)
+    /norm/     x_mean, x_std, c_mean, c_std      (float64; c_* empty for a P-VAE)
+    /latent/   z_mean, z_std                     (whitening of the latent action)
+    /metrics/  one scalar per metric (latent_dim, recon_rmse_heldout, pca_rmse_heldout, ...)
+
+Every problem with a prior (no reference given, no such file or run, not a prior, a truncated or
+inconsistent file, the wrong kind) is one ``JtError`` line that says how to make one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from toolkit.errors import JtError
+from toolkit.motion.features import FeatureLayout
+from toolkit.priors.model import KINDS, PosePrior
+
+FORMAT = "jt.pose_prior"
+VERSION = 1
+FILENAME = "prior.h5"
+_RUN_ID = re.compile(r"^[0-9a-f]{32}$")
+
+
+def how_to_make(kind: str = "pvae") -> str:
+    """The hint every prior error ends with."""
+    return f"make one with: jt run task=pose_prior action={kind if kind in KINDS else 'pvae'}"
+
+
+def _first_line(e: BaseException) -> str:
+    text = str(e).strip()
+    return text.splitlines()[0] if text else type(e).__name__
+
+
+def save_prior(prior: PosePrior, path: str | os.PathLike) -> Path:
+    """Write ``prior`` to ``path`` (atomic: temp file, fsync, rename)."""
+    from toolkit.store import h5
+
+    attrs = {
+        "format": FORMAT, "version": VERSION, "kind": prior.kind, "skeleton": prior.layout.skeleton,
+        "latent_dim": int(prior.latent_dim), "feature_layout": prior.layout.to_json(),
+        "condition_names": json.dumps(list(prior.condition_names)),
+        "info": json.dumps(prior.info, default=str),
+    }  # fmt: skip
+    data = {
+        "weights": {k: np.asarray(v, dtype=np.float32) for k, v in prior.weights.items()},
+        "norm": {"x_mean": prior.x_mean, "x_std": prior.x_std, "c_mean": prior.c_mean, "c_std": prior.c_std},
+        "latent": {"z_mean": prior.z_mean, "z_std": prior.z_std},
+        "metrics": {k: float(v) for k, v in prior.metrics.items()},
+    }
+    return h5.write(path, data, attrs)
+
+
+def _is_prior_file(path: Path) -> bool:
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            fmt = f.attrs.get("format")
+    except (OSError, ValueError):
+        return False
+    return (fmt.decode() if isinstance(fmt, bytes) else fmt) == FORMAT
+
+
+def read_prior(path: str | os.PathLike, kind: Optional[str] = None) -> PosePrior:
+    """Read a prior file; ``kind`` (if given) must match.
+
+    Raises:
+        JtError: missing, unreadable, not a prior, malformed, or of another kind.
+    """
+    import h5py
+
+    path = Path(path)
+    hint = how_to_make(kind or "pvae")
+    if not path.is_file():
+        raise JtError(f"no pose prior at {path}; {hint}")
+    try:
+        with h5py.File(path, "r") as f:
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+            if attrs.get("format") != FORMAT:
+                raise JtError(f"{path} is not a jt pose prior (format={attrs.get('format')!r}); {hint}")
+            if int(attrs.get("version", -1)) != VERSION:
+                raise JtError(f"{path}: pose prior version {attrs.get('version')} is not {VERSION}; {hint}")
+            groups: dict[str, dict[str, Any]] = {}
+            for g in ("weights", "norm", "latent", "metrics"):
+                if g not in f:
+                    raise JtError(f"{path}: malformed pose prior (no /{g}); {hint}")
+                groups[g] = {k: f[g][k][()] for k in f[g]}
+    except JtError:
+        raise
+    except (OSError, KeyError, ValueError) as e:
+        raise JtError(f"{path}: unreadable pose prior ({_first_line(e)}); {hint}") from e
+    try:
+        w, norm, lat = groups["weights"], groups["norm"], groups["latent"]
+        prior = PosePrior(
+            kind=str(attrs["kind"]), layout=FeatureLayout.from_json(attrs["feature_layout"]),
+            latent_dim=int(attrs["latent_dim"]), weights={k: np.asarray(v) for k, v in w.items()},
+            x_mean=norm["x_mean"], x_std=norm["x_std"], c_mean=norm["c_mean"], c_std=norm["c_std"],
+            z_mean=lat["z_mean"], z_std=lat["z_std"],
+            condition_names=tuple(json.loads(attrs.get("condition_names", "[]"))),
+            metrics={k: float(v) for k, v in groups["metrics"].items()},
+            info=json.loads(attrs.get("info", "{}")),
+        )  # fmt: skip
+        _check_shapes(prior)
+    except JtError:
+        raise
+    except (KeyError, ValueError, TypeError) as e:
+        raise JtError(f"{path}: malformed pose prior ({type(e).__name__}: {_first_line(e)}); {hint}") from e
+    if kind is not None and prior.kind != kind:
+        raise JtError(f"{path} holds a {prior.kind} prior, action={kind} needs a {kind} one; {how_to_make(kind)}")
+    return prior
+
+
+def _check_shapes(p: PosePrior) -> None:
+    """Raise ValueError when arrays do not fit together (a corrupted or hand-edited file)."""
+    d, k, nc = p.layout.size, p.latent_dim, p.n_cond
+    if p.x_mean.shape != (d,) or p.x_std.shape != (d,):
+        raise ValueError(f"feature normalisation has shape {p.x_mean.shape}, layout has {d} columns")
+    if p.z_mean.shape != (k,) or p.z_std.shape != (k,):
+        raise ValueError(f"latent statistics have shape {p.z_mean.shape}, latent_dim is {k}")
+    if p.conditional != (nc > 0):
+        raise ValueError(f"a {p.kind} prior with {nc} condition entries")
+    z = np.zeros((1, k))
+    c = np.zeros((1, nc)) + p.c_mean if nc else None
+    out = p.decode(z, c)
+    if out.shape != (1, d) or not np.all(np.isfinite(out)):
+        raise ValueError("the decoder does not map a latent to a finite feature row")
+    mu, _ = p.encode(np.zeros((1, d)) + p.x_mean, c)
+    if mu.shape != (1, k):
+        raise ValueError(f"the encoder gives {mu.shape[-1]} latents, latent_dim is {k}")
+
+
+def find_in_run(run_id: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
+    """The prior file among the artifacts of MLflow run ``run_id`` (or of its child runs).
+
+    Raises:
+        JtError: no store, no such run, or no prior among its artifacts.
+    """
+    from toolkit.store.tracking import Store
+    from toolkit.store.tracking import store_root as resolve_root
+
+    root = resolve_root(store_root)
+    if not (root / "mlflow.db").is_file():
+        raise JtError(f"no pose prior '{run_id}': not a file, and there is no store at {root}; {how_to_make(kind)}")
+    store = Store(root)
+    try:
+        run = store.get_run(run_id)
+    except JtError as e:
+        raise JtError(f"no pose prior '{run_id}': not a file, and {e}; {how_to_make(kind)}") from None
+    dirs = [store.artifact_dir(run_id)]
+    children = store.client.search_runs([run.info.experiment_id], filter_string=f"tags.mlflow.parentRunId = '{run_id}'")
+    dirs += [store.artifact_dir(c.info.run_id) for c in children]
+    found = []
+    for d in dirs:
+        if d.is_dir():
+            found += [p for p in sorted(d.rglob("*.h5")) if _is_prior_file(p)]
+    if not found:
+        raise JtError(f"run {run_id} has no pose prior ({FILENAME}) among its artifacts; {how_to_make(kind)}")
+    named = [p for p in found if p.name == FILENAME]
+    return (named or found)[0]
+
+
+def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] = None) -> PosePrior:
+    """Load a prior from a file path, a folder holding one, or the id of the MLflow run that made it.
+
+    Args:
+        ref: path to a ``prior.h5`` (or a folder with one), or an MLflow run id.
+        store_root: store to look the run up in (``$JT_STORE`` or ``./artifacts`` when ``None``).
+        kind: the kind the caller needs (``"pvae"`` / ``"cvae"``), checked if given.
+
+    Raises:
+        JtError: one line, ending with how to make a prior.
+    """
+    text = "" if ref is None else str(ref).strip()
+    if not text:
+        need = kind or "pvae"
+        raise JtError(f"action={need} needs a pose prior (action.prior=RUN_ID or PATH); {how_to_make(need)}")
+    path = Path(text).expanduser()
+    if path.is_dir():
+        cands = [p for p in sorted(path.rglob("*.h5")) if _is_prior_file(p)]
+        if not cands:
+            raise JtError(f"no pose prior in {path}; {how_to_make(kind or 'pvae')}")
+        named = [p for p in cands if p.name == FILENAME]
+        return read_prior((named or cands)[0], kind)
+    if path.exists() or not _RUN_ID.match(text):
+        return read_prior(path, kind)
+    return read_prior(find_in_run(text, store_root, kind or "pvae"), kind)
