@@ -11,7 +11,12 @@ from toolkit.interfaces import Executor, Searcher, Task
 
 EXPECTED_BUILTINS = {
     "executor": {"local", "ray"},
-    "search": {"single"},
+    "search": {"single", "random", "bds", "rmoo", "bsoo"},
+    "spd": {"maba", "df", "sf", "pcg", "bullet"},
+    "action": {"raw", "pvae", "cvae", "ffc_fbc"},
+    "reward": {"task_complete", "root_rotation", "safety", "naturalness", "novelty"},
+    "curriculum": {"bar_height", "obstacle_width", "terrain"},
+    "task": {"strategy_landscape", "zdt1", "pose_prior"},
 }
 
 
@@ -31,7 +36,10 @@ def test_builtins_discovered_through_entry_points(kind):
 
 
 def test_every_builtin_loads_and_implements_its_interface():
-    base = {"task": Task, "search": Searcher, "executor": Executor}
+    from toolkit.interfaces import ActionSpace, Curriculum, RewardTerm, Simulator, SPDBackend
+
+    base = {"task": Task, "search": Searcher, "executor": Executor, "spd": SPDBackend,
+            "action": ActionSpace, "reward": RewardTerm, "curriculum": Curriculum, "sim": Simulator}
     for kind, cls_base in base.items():
         for name in plugins.names(kind):
             info = next(i for i in plugins.available(kind) if i.name == name)

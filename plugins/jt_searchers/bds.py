@@ -1,0 +1,176 @@
+"""``search=bds``: Bayesian Diversity Search (``000`` §5.1 Alg. 1; ``001`` §3.5.1), with batches.
+
+Algorithm 1: ``n_init`` random samples initialise a GP surrogate of the feature map ``g(x)``; then
+model-based picks alternate ``n_exp`` exploration picks (argmax posterior std, eq 9, by
+multi-start L-BFGS-B) and ``n_opt`` diversity picks (argmax of the Monte-Carlo expected minimum
+feature distance to the observed features, eq 7, by DIRECT). The GP's hyperparameters are re-learned
+after every tell (Alg. 1 line 11).
+
+Batches (beyond the paper, which is sequential; its §8 suggests batched BDS as future work): an
+``ask(q)`` makes ``q`` picks greedily; after each pick the model *believes* its posterior mean
+there (kriging believer: the point is added to the GP data with the mean as its value and to the
+observed feature set, hyperparameters unchanged), so exploration picks stop seeing uncertainty at
+the picked point and diversity picks see its predicted strategy as taken — the ``q`` points are
+diverse among themselves. Points asked but not yet told are believed the same way. Picks keep
+alternating exploration/diversity across the batch exactly as in the sequential schedule.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from jt_searchers.acquisition import ExpectedDiversity, Exploration
+from jt_searchers.base import BudgetedSearcher, seed_int
+from jt_searchers.distances import resolve
+from jt_searchers.gp import FeatureGP
+from jt_searchers.optimize import maximize_direct, maximize_lbfgsb
+from jt_searchers.random_search import unit_samples
+
+KINDS = ("init", "explore", "diversity")
+
+
+class BDSSearcher(BudgetedSearcher):
+    """Bayesian Diversity Search: GP surrogate of features, alternating exploration / diversity picks."""
+
+    @dataclasses.dataclass
+    class Config:
+        budget: int = 10  # total evaluations, initial samples included; 000 §7.1.1 counts the first ten
+        batch: int = 1  # points per ask; 1 = Alg. 1 exactly (000 §5.1); >1 = batch BDS (docs/searchers.md)
+        n_init: int = 3  # random samples that initialise the GP (000 Alg. 1 line 2 gives no number; ours)
+        n_exp: int = 3  # exploration picks per round (000 §6.2)
+        n_opt: int = 3  # diversity picks per round (000 §6.2)
+        init_method: str = "uniform"  # "uniform" or "sobol" for the initial samples
+        n_mc: int = 128  # Monte-Carlo draws for eq 7 (fixed, seeded)
+        direct_maxfun: int = 2000  # DIRECT evaluation budget per diversity pick
+        lbfgs_starts: int = 8  # L-BFGS-B starts per exploration pick (best of 512 candidates + random)
+        gp_restarts: int = 3  # extra seeded starts of the marginal-likelihood optimisation
+        feature_distance: Optional[str] = None  # "euclidean" | "angle" | "quaternion"; None: the task's
+
+    def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
+        super().__init__(problem, cfg, seed)
+        c = self.cfg
+        if problem.n_features <= 0:
+            raise ValueError("bds needs a task whose problem() declares n_features > 0")
+        if c.n_init < 1 or c.n_exp < 0 or c.n_opt < 0 or c.n_exp + c.n_opt < 1:
+            raise ValueError("bds needs n_init >= 1 and n_exp + n_opt >= 1")
+        m = problem.n_features
+        low = np.asarray(problem.feature_low if problem.feature_low is not None else [-1.0] * m, float)
+        high = np.asarray(problem.feature_high if problem.feature_high is not None else [1.0] * m, float)
+        half = 0.5 * (high - low)
+        self._centre = 0.5 * (low + high)  # prior mean = centre of the feature range (000 §6.1.5)
+        self._half = np.where(half > 0, half, 1.0)
+        self._distance = resolve(c.feature_distance or problem.feature_distance)
+        self._init = unit_samples(c.n_init, self.box.dim, seed_int(seed, 0), c.init_method)
+        self._z = np.random.default_rng(seed_int(seed, 1)).standard_normal((c.n_mc, m))
+        self._gp = FeatureGP(self.box.dim, self._centre, self._half)
+        self._fitted_at = -1  # n_told when the hyperparameters were last learned
+        self.U: list[np.ndarray] = []  # told unit points
+        self.F: list[np.ndarray] = []  # told features (NaN row when failed / missing)
+        self.kinds: list[str] = []  # kind of every asked point
+        self.acq: list[float] = []  # acquisition value of every asked point (NaN for init)
+        self._n_model_picks = 0
+
+    # ---- the model ------------------------------------------------------------------------------
+
+    def _observed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Told data: unit points ``(t, dim)``, features ``(t, m)``, mask of usable rows ``(t,)``."""
+        m = self.problem.n_features
+        U = np.array(self.U).reshape(-1, self.box.dim)
+        F = np.array(self.F).reshape(-1, m)
+        return U, F, np.all(np.isfinite(F), axis=1)
+
+    def _model(self) -> FeatureGP:
+        """GP fitted on the told data, then believing every point without a usable feature.
+
+        Points asked but not told, and told failures without features, are believed at the posterior
+        mean: they carry no feature information, but they are no longer unexplored.
+        """
+        U, F, ok = self._observed()
+        if self._fitted_at != self.n_told:
+            # Learned from fixed initial hyperparameters (no warm start), so the fit depends only on
+            # the data and the seed: a replayed run refits to exactly the same model.
+            self._gp = FeatureGP(self.box.dim, self._centre, self._half)
+            self._gp.fit(U[ok], F[ok], seed=seed_int(self.seed, 2, self.n_told),
+                         n_restarts=self.cfg.gp_restarts)
+            self._fitted_at = self.n_told
+        gp = FeatureGP(self.box.dim, self._centre, self._half, self._gp.lengthscales,
+                       self._gp.amplitude, self._gp.noise).condition(U[ok], self._gp.standardise(F[ok]))
+        for u in list(U[~ok]) + list(self._pending):
+            gp = gp.fantasise(u)
+        return gp
+
+    def _believed_features(self, gp: FeatureGP) -> np.ndarray:
+        """Observed features plus the believed ones of pending points, raw units ``(t', m)``."""
+        _, F, ok = self._observed()
+        if not self._pending:
+            return F[ok]
+        mean, _ = gp.predict(np.array(self._pending))
+        return np.vstack([F[ok], mean])
+
+    # ---- picks ----------------------------------------------------------------------------------
+
+    def _explore(self, gp: FeatureGP, j: int) -> tuple[np.ndarray, float]:
+        """argmax sigma (eq 9) by L-BFGS-B from the best of 512 seeded candidates + random starts."""
+        acq = Exploration(gp)
+        rng = np.random.default_rng(seed_int(self.seed, 3, j))
+        cand = rng.random((512, self.box.dim))
+        vals = acq(cand)
+        order = np.argsort(-vals, kind="stable")
+        others = rng.choice(order[1:], self.cfg.lbfgs_starts - 1, replace=False)
+        starts = cand[np.concatenate([order[:1], others])]
+        return maximize_lbfgsb(acq.value_and_grad, starts)
+
+    def _diversify(self, gp: FeatureGP, observed: np.ndarray) -> tuple[np.ndarray, float]:
+        """argmax of the MC expected minimum feature distance (eq 7) by DIRECT."""
+        acq = ExpectedDiversity(gp, observed, self._distance, self._z)
+        return maximize_direct(acq.scalar(), self.box.dim, maxfun=self.cfg.direct_maxfun)
+
+    def _propose(self, k: int) -> np.ndarray:
+        c = self.cfg
+        if self.n_asked < c.n_init:  # Alg. 1 line 2: random samples initialise the GP
+            u = self._init[self.n_asked : min(c.n_init, self.n_asked + k)]
+            self.kinds += ["init"] * len(u)
+            self.acq += [float("nan")] * len(u)
+            return u
+        gp = self._model()
+        observed = self._believed_features(gp)
+        picks = []
+        for _ in range(k):
+            j = self._n_model_picks
+            if j % (c.n_exp + c.n_opt) < c.n_exp:  # Alg. 1 line 4
+                u, v = self._explore(gp, j)
+                self.kinds.append("explore")
+            else:
+                u, v = self._diversify(gp, observed)
+                self.kinds.append("diversity")
+            self.acq.append(v)
+            self._n_model_picks += 1
+            picks.append(u)
+            mean, _ = gp.predict(u[None])  # kriging believer for the rest of the batch
+            observed = np.vstack([observed, mean])
+            gp = gp.fantasise(u)
+        return np.array(picks)
+
+    def _observe(self, u: np.ndarray, results: Sequence[Any]) -> None:
+        m = self.problem.n_features
+        for row, r in zip(u, results):
+            f = np.asarray(r.features, dtype=float).ravel()
+            if r.failed or f.size != m:
+                f = np.full(m, np.nan)
+            self.U.append(row)
+            self.F.append(f)
+
+    def summary(self) -> dict[str, Any]:
+        U, F, ok = self._observed()
+        out = {
+            "X": self.box.from_unit(U),  # told points (n, dim)
+            "features": F,  # (n, m), NaN rows for failures
+            "usable": ok,  # rows in the GP's training data
+            "pick_kind": np.array(self.kinds[: len(U)], dtype=str),  # "init" | "explore" | "diversity"
+            "acquisition": np.array(self.acq[: len(U)], dtype=float),
+        }
+        out.update({f"gp_{k}": v for k, v in self._gp.hyperparameters().items()})
+        return out

@@ -1,0 +1,62 @@
+"""``search=random``: seeded uniform or scrambled-Sobol samples of the box.
+
+The baseline BDS is compared with (``000`` §7.2.1), and the initial design of BDS.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Sequence
+
+import numpy as np
+
+from jt_searchers.base import BudgetedSearcher
+
+
+def unit_samples(n: int, dim: int, seed: int, method: str = "uniform") -> np.ndarray:
+    """``n`` points of the unit cube ``(n, dim)``, a deterministic function of the arguments.
+
+    Args:
+        n: number of points.
+        dim: dimension.
+        seed: seed of the generator (or of the Sobol scrambling).
+        method: ``"uniform"`` (i.i.d.) or ``"sobol"`` (scrambled Sobol', ``scipy.stats.qmc``).
+    """
+    if method == "uniform":
+        return np.random.default_rng(seed).random((n, dim))
+    if method == "sobol":
+        from scipy.stats import qmc
+
+        if n == 0 or dim == 0:
+            return np.zeros((n, dim))
+        try:
+            sampler = qmc.Sobol(d=dim, scramble=True, rng=np.random.default_rng(seed))
+        except TypeError:  # scipy < 1.15 names the argument ``seed``
+            sampler = qmc.Sobol(d=dim, scramble=True, seed=np.random.default_rng(seed))
+        m = int(np.ceil(np.log2(max(n, 1))))
+        return sampler.random_base2(m)[:n]  # a power of two keeps the balance properties
+    raise ValueError(f"unknown sampling method {method!r} (use 'uniform' or 'sobol')")
+
+
+class RandomSearcher(BudgetedSearcher):
+    """Uniform (or scrambled-Sobol) random samples of the box, seeded."""
+
+    @dataclasses.dataclass
+    class Config:
+        budget: int = 10  # total evaluations; 000 §7.2.1 compares the first ten samples
+        batch: int = 1  # points per ask (evaluated in parallel by the runner)
+        method: str = "uniform"  # "uniform" (i.i.d.) or "sobol" (scrambled Sobol', scipy.stats.qmc)
+
+    def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
+        super().__init__(problem, cfg, seed)
+        # The whole design is drawn up front, so the points never depend on how asks are batched.
+        self._design = unit_samples(self.budget, self.box.dim, seed, self.cfg.method)
+
+    def _propose(self, k: int) -> np.ndarray:
+        return self._design[self.n_asked : self.n_asked + k]
+
+    def _observe(self, u: np.ndarray, results: Sequence[Any]) -> None:
+        pass
+
+    def summary(self) -> dict[str, Any]:
+        return {"design": self.box.from_unit(self._design[: self.n_asked])}

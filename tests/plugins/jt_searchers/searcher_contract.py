@@ -1,0 +1,147 @@
+"""The contract every searcher test class inherits: bounds, batches, budget, determinism, resume.
+
+A subclass sets ``searcher_cls``, ``cfg`` (a dict for the search group), ``batch`` and
+``make_task()``; the test methods here then run against the real task. Golden points (first points
+for seed 0) live in ``golden/<golden_name>.json``; regenerate them with
+
+    JT_REGEN_GOLDEN=1 PYTHONPATH=.:plugins python -m pytest tests/plugins/jt_searchers -k golden
+
+and commit the JSON only when the change of points is intended.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+import pytest
+
+from searcher_loop import eval_seed
+from toolkit.interfaces.task import EvalContext
+
+GOLDEN_DIR = Path(__file__).parent / "golden"
+
+
+def run_batches(searcher: Any, task: Any, batch: int, seed: int, max_batches: int = 10_000) -> list[tuple[np.ndarray, list]]:
+    """Drive ``searcher`` to the end; the recorded ``(X, evaluations)`` of every batch."""
+    problem = task.problem()
+    workdir = Path(tempfile.mkdtemp(prefix="jt_contract_"))
+    out, n = [], 0
+    for _ in range(max_batches):
+        if searcher.finished():
+            break
+        X = searcher.ask(batch)
+        if len(X) == 0:
+            break
+        evs = []
+        for x in X:
+            evs.append(task.evaluate(problem.space.to_dict(x), EvalContext(n, eval_seed(seed, n), workdir)))
+            n += 1
+        searcher.tell(X, evs)
+        out.append((np.array(X), evs))
+    return out
+
+
+class SearcherContract:
+    """Tests every searcher must pass (subclass it as ``TestXxx``)."""
+
+    searcher_cls: ClassVar[type]
+    cfg: ClassVar[dict] = {}
+    batch: ClassVar[int] = 1
+    golden_name: ClassVar[str] = ""
+    golden_points: ClassVar[int] = 6
+    golden_atol: ClassVar[float] = 1e-6
+
+    def make_task(self) -> Any:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def make(self, seed: int = 0, **over: Any) -> tuple[Any, Any]:
+        task = self.make_task()
+        return self.searcher_cls(task.problem(), dict(self.cfg, **over), seed), task
+
+    def test_asks_in_bounds_with_batch_sizes(self) -> None:
+        s, task = self.make()
+        space = task.problem().space
+        batches = run_batches(s, task, self.batch, seed=0)
+        assert batches
+        for X, _ in batches:
+            assert X.ndim == 2 and X.shape[1] == space.dim
+            assert 1 <= len(X) <= self.batch
+            assert np.all(X >= np.array(space.lows)) and np.all(X <= np.array(space.highs))
+
+    def test_finished_after_budget(self) -> None:
+        s, task = self.make()
+        batches = run_batches(s, task, self.batch, seed=0)
+        n = sum(len(X) for X, _ in batches)
+        assert s.finished()
+        assert n <= self.cfg["budget"]
+        assert n == self.cfg["budget"] or s._converged()
+        assert s.ask(self.batch).shape == (0, task.problem().space.dim)
+
+    def test_same_seed_same_points(self) -> None:
+        a, task = self.make(seed=3)
+        b, _ = self.make(seed=3)
+        c, _ = self.make(seed=4)
+        xa = np.vstack([X for X, _ in run_batches(a, task, self.batch, seed=3)])
+        np.random.seed(123)  # global numpy state must not matter
+        xb = np.vstack([X for X, _ in run_batches(b, task, self.batch, seed=3)])
+        xc = np.vstack([X for X, _ in run_batches(c, task, self.batch, seed=4)])
+        np.testing.assert_array_equal(xa, xb)
+        assert xa.shape != xc.shape or not np.allclose(xa, xc)
+
+    def test_replay_resume_gives_the_next_points(self) -> None:
+        full, task = self.make(seed=1)
+        batches = run_batches(full, task, self.batch, seed=1)
+        assert len(batches) >= 2
+        cut = len(batches) // 2
+        resumed, _ = self.make(seed=1)
+        for X, evs in batches[:cut]:  # what the runner does on resume: replay the recorded history
+            np.testing.assert_allclose(resumed.ask(self.batch), X, rtol=0, atol=1e-12)
+            resumed.tell(X, evs)
+        np.testing.assert_allclose(resumed.ask(self.batch), batches[cut][0], rtol=0, atol=1e-12)
+
+    def test_tell_rejects_points_it_did_not_ask(self) -> None:
+        s, task = self.make()
+        X = s.ask(self.batch)
+        evs = [task.evaluate(task.problem().space.to_dict(x), EvalContext(i, i, Path("."))) for i, x in enumerate(X)]
+        Y = X.copy()
+        Y[0, 0] += 1e-3 if Y[0, 0] + 1e-3 <= task.problem().space.highs[0] else -1e-3
+        with pytest.raises(ValueError):
+            s.tell(Y, evs)
+
+    def test_summary_goes_to_hdf5(self, tmp_path: Path) -> None:
+        from toolkit.store import h5
+
+        s, task = self.make()
+        run_batches(s, task, self.batch, seed=0)
+        summary = s.summary()
+        assert summary
+        path = h5.write(tmp_path / "search.h5", {"searcher": summary})
+        back = h5.read(path)["searcher"]
+        assert set(back) == set(summary)
+        for k, v in summary.items():
+            if np.asarray(v).dtype.kind in "fiub":
+                np.testing.assert_array_equal(np.asarray(back[k]), np.asarray(v))
+
+    def test_golden_points(self) -> None:
+        if not self.golden_name:
+            pytest.skip("no golden file for this searcher")
+        s, task = self.make(seed=0)
+        X = np.vstack([X for X, _ in run_batches(s, task, self.batch, seed=0)])[: self.golden_points]
+        path = GOLDEN_DIR / f"{self.golden_name}.json"
+        if os.environ.get("JT_REGEN_GOLDEN"):
+            path.write_text(json.dumps({
+                "searcher": self.searcher_cls.__name__,
+                "cfg": self.cfg,
+                "batch": self.batch,
+                "seed": 0,
+                "points": X.tolist(),
+                "regenerate": "JT_REGEN_GOLDEN=1 PYTHONPATH=.:plugins python -m pytest tests/plugins/jt_searchers -k golden",
+            }, indent=1) + "\n")
+        golden = json.loads(path.read_text())
+        assert golden["cfg"] == self.cfg, "config changed: regenerate the golden file"
+        np.testing.assert_allclose(X, np.array(golden["points"]), rtol=0, atol=self.golden_atol)

@@ -1,0 +1,52 @@
+"""A tiny ask → evaluate → tell loop for tests and benchmarks (the lead's runner does this for real)."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from toolkit.interfaces.task import EvalContext
+
+
+def eval_seed(run_seed: int, index: int) -> int:
+    """Seed of evaluation ``index`` of a run, derived from the run seed."""
+    return int(np.random.SeedSequence([run_seed, index]).generate_state(1)[0])
+
+
+def run_search(
+    searcher_cls: type,
+    task: Any,
+    cfg: Any,
+    seed: int,
+    batch: Optional[int] = None,
+    workdir: Optional[Path] = None,
+    max_steps: int = 100_000,
+) -> tuple[Any, np.ndarray, list]:
+    """Run a searcher on a task until ``finished()``.
+
+    Returns:
+        The searcher, the evaluated points ``(n, dim)`` and the evaluations, in order.
+    """
+    problem = task.problem()
+    s = searcher_cls(problem, cfg, seed)
+    batch = batch or int(getattr(s.cfg, "batch", 1))
+    workdir = Path(workdir or tempfile.mkdtemp(prefix="jt_search_"))
+    points, evals = [], []
+    for _ in range(max_steps):
+        if s.finished():
+            break
+        X = s.ask(batch)
+        if len(X) == 0:
+            break
+        res = []
+        for x in X:
+            i = len(evals) + len(res)
+            ctx = EvalContext(index=i, seed=eval_seed(seed, i), workdir=workdir)
+            res.append(task.evaluate(problem.space.to_dict(x), ctx))
+        s.tell(X, res)
+        points.extend(X)
+        evals.extend(res)
+    return s, np.array(points).reshape(-1, problem.space.dim), evals
