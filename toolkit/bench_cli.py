@@ -52,17 +52,19 @@ def bench_spd(
     check: bool = typer.Option(False, "--check", help="Only check that all backends agree (≤ 1e-8)."),
 ) -> None:
     """Time the SPD solve and the whole simulation step per model and backend (thesis Tables 2.2/2.3)."""
+    from toolkit import plugins
     from toolkit.dynamics import bench
 
     model_list = _split(models, MODELS, "model")
+    loader = plugins.load("sim", "bullet").load_character  # characters through the registry
     if check:
-        worst = bench.check_agreement(model_list, n_states=20, seed=seed)
+        worst = bench.check_agreement(model_list, n_states=20, seed=seed, loader=loader)
         typer.echo(f"largest relative torque difference between backends: {worst:.3e} (limit 1e-8)")
         if not worst <= 1e-8:
             raise typer.Exit(1)
         return
     backend_list = _split(backends, BACKENDS, "backend")
-    rows = bench.time_spd(model_list, backend_list, n_samples=samples, seed=seed)
+    rows = bench.time_spd(model_list, backend_list, n_samples=samples, seed=seed, loader=loader)
     header = f"{'model':<10} {'dof':>4} {'depth':>5} {'backend':<8} {'solve_us':>10} {'step_us':>10} {'share%':>7}"
     typer.echo(header)
     for r in rows:

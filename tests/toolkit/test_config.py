@@ -30,7 +30,7 @@ def test_plugin_shipped_preset_applies(example_plugin):
         (["task=quadratic", "seed=abc"], "seed"),
         (["task=quadratic", "experiment=nah"], "unknown experiment 'nah'; choose one of: default"),
         (["task=quadratic", "task.centre=[1,"], "bad override"),
-        ([], "choose a task"),
+        (["task=quadratic", "character=robot"], "unknown character 'robot'; choose one of: atlas"),
     ],
 )
 def test_bad_input_is_one_line(example_plugin, overrides, expected):

@@ -16,7 +16,8 @@ EXPECTED_BUILTINS = {
     "action": {"raw", "pvae", "cvae", "ffc_fbc"},
     "reward": {"task_complete", "root_rotation", "safety", "naturalness", "novelty"},
     "curriculum": {"bar_height", "obstacle_width", "terrain"},
-    "task": {"strategy_landscape", "zdt1", "pose_prior"},
+    "task": {"strategy_landscape", "zdt1", "pose_prior", "spd_tracking"},
+    "sim": {"bullet"},
 }
 
 

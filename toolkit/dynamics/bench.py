@@ -8,9 +8,9 @@
 * ``check_agreement`` returns the largest relative torque difference between the four solvers.
 * ``summarize`` turns the rows into the ratios the targets in ``docs/maba.md`` are stated in.
 
-Characters come from ``loader(name, client)``; by default the built-in ``jt_bullet.characters``
-(imported lazily, the one place ``toolkit`` reaches into a built-in plugin; pass ``loader`` to use
-another source).
+Characters come from ``loader(name, client)``; by default the ``bullet`` simulator plugin's
+``load_character`` found through the registry (``toolkit`` never imports a plugin module); pass
+``loader`` to use another source.
 """
 
 from __future__ import annotations
@@ -29,10 +29,11 @@ BACKENDS = METHODS + ("bullet",)
 SOLVE_BLOCK = 10  #: consecutive solves per backend before switching (keeps caches warm)
 
 
-def _default_loader(name: str, client: int) -> Any:
-    from jt_bullet.characters import load
+def default_loader() -> Callable[[str, int], Any]:
+    """``load_character`` of the registered ``bullet`` simulator (``jt.simulators``)."""
+    from toolkit import plugins
 
-    return load(name, client)
+    return plugins.load("sim", "bullet").load_character
 
 
 def _world(dt: float) -> int:
@@ -87,7 +88,7 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
         n_samples: timed solves (random states) and timed substeps per backend.
         seed: seeds the random states and targets.
         dt: simulation time step (600 Hz as the jumping papers).
-        loader: ``loader(name, client) -> Character``; default ``jt_bullet.characters.load``.
+        loader: ``loader(name, client) -> Character``; default ``default_loader()``.
 
     Returns:
         One row per (model, backend): ``model``, ``dof``, ``depth``, ``backend``,
@@ -97,7 +98,7 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
     """
     import pybullet as pb
 
-    load = loader or _default_loader
+    load = loader or default_loader()
     rows = []
     for name in model_names:
         rng = np.random.default_rng(seed)
@@ -172,7 +173,7 @@ def check_agreement(models: Sequence[str], n_states: int = 20, seed: int = 0,
     """Largest ``max|tau_m - tau_df| / max|tau_df|`` over models, random states and methods."""
     import pybullet as pb
 
-    load = loader or _default_loader
+    load = loader or default_loader()
     worst = 0.0
     for name in models:
         rng = np.random.default_rng(seed)

@@ -1,0 +1,297 @@
+"""``sim=bullet``: one SPD-controlled character in a PyBullet world (y-up, ground plane).
+
+Per control step (``control_hz``) the simulator runs ``sim_hz / control_hz`` substeps; in each,
+the configured SPD backend (``cfg.spd``) computes torques towards the control step's target from
+the current state, the torques are clipped to the character's limits (after the solve, as
+DeepMimic and PyBullet do) and applied, and PyBullet steps once. A backend with
+``steps_itself`` (``spd=bullet``, PyBullet's own STABLE_PD) is armed instead and acts inside the
+step. A hand-of-God root servo (``sim.root_servo``, thesis ``001`` §2.4.1) puts SPD gains on the
+6 root DoFs; our backends solve it jointly with the internal joints.
+
+A NaN or exploding state ends the episode as a failure with a reason (later steps return the
+same failed record without simulating); ``step`` never raises for it.
+
+Timers: ``timers["spd_s"]`` accumulates the wall time of the SPD solves alone,
+``timers["substep_s"]`` that of whole substeps (read state, solve, clip, apply, step), and
+``timers["substeps"]`` their count; ``spd_share`` is the thesis' Table 2.3 ratio. Setting
+``step_log`` to a list makes every substep append ``(spd_s, substep_s)`` to it (for medians).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, ClassVar
+
+import numpy as np
+
+from jt_bullet.config import DEFAULT_CAMERA, CharacterConfig, SimConfig, typed
+from toolkit.interfaces import Simulator
+
+
+def _get(cfg: Any, key: str) -> Any:
+    if cfg is None:
+        return None
+    if isinstance(cfg, dict):
+        return cfg.get(key)
+    return cfg.get(key) if hasattr(cfg, "get") else getattr(cfg, key, None)
+
+
+class BulletSimulator(Simulator):
+    """PyBullet world (y-up, ground) with one character driven by an SPD backend per substep."""
+
+    Config: ClassVar[type] = SimConfig
+
+    def __init__(self, cfg: Any) -> None:
+        import pybullet as pb
+
+        from toolkit import plugins
+        from toolkit.dynamics.bullet_io import PYBULLET_MAX_Q, BulletBody
+        from toolkit.errors import JtError
+        from jt_bullet import scene
+
+        super().__init__(cfg)
+        self.params: SimConfig = typed(SimConfig, _get(cfg, "sim"), "sim")
+        self.char_cfg = CharacterConfig.from_node(_get(cfg, "character"))
+        p = self.params
+        if not (p.sim_hz > 0 and p.control_hz > 0):
+            raise JtError(f"sim: sim_hz and control_hz must be positive, got {p.sim_hz}, "
+                          f"{p.control_hz}")
+        ratio = p.sim_hz / p.control_hz
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise JtError(f"sim: sim_hz / control_hz must be a whole number >= 1, got "
+                          f"{p.sim_hz} / {p.control_hz} = {ratio:g}")
+        self.n_substeps = int(round(ratio))
+        self.dt = 1.0 / p.sim_hz
+        spd_node = _get(cfg, "spd")
+        spd_name = str(_get(spd_node, "name") or "maba")
+        self.backend = plugins.load("spd", spd_name)(spd_node)
+        self.steps_itself = bool(getattr(self.backend, "steps_itself", False))
+        if self.steps_itself and p.root_servo.kp != 0.0:
+            raise JtError(f"spd={spd_name} cannot drive a root servo (PyBullet's STABLE_PD leaves "
+                          "the root unactuated); use spd=maba/df/sf/pcg or sim.root_servo.kp=0")
+
+        self.client, self.ground_id = scene.connect(self.dt, p.gravity, p.ground, p.friction,
+                                                    p.solver_iterations)
+        self._kw = {"physicsClientId": self.client}
+        self._pb = pb
+        kw = {} if p.self_collision is None else {"self_collision": bool(p.self_collision)}
+        self.character = self.load_character(self.char_cfg, self.client, **kw)
+        body = self.character.body_id
+        scene.set_friction(self.client, body, p.friction)
+        self.model = self.character.model()
+        if self.model.n_q > PYBULLET_MAX_Q:
+            self.close()
+            raise JtError(f"character={self.char_cfg.name}: {self.model.n_q} position coordinates "
+                          f"exceed PyBullet's limit of {PYBULLET_MAX_Q} per body; it cannot be "
+                          "simulated (docs/maba.md)")
+        self.io = BulletBody(self.client, body, self.model)
+        self.backend.bind(self.io if self.steps_itself else self.model)
+        self.n_links = pb.getNumJoints(body, **self._kw)
+
+        self.kp = np.array(self.character.kp, dtype=float)
+        self.kd = np.array(self.character.kd, dtype=float)
+        limit = np.array(self.character.torque_limit, dtype=float)
+        if not p.torque_limits:
+            limit[:] = np.inf
+        if not self.character.fixed_base:
+            self.kp[:6] = p.root_servo.kp
+            self.kd[:6] = p.root_servo.kd
+            limit[:6] = np.inf if p.root_servo.kp or p.root_servo.kd else 0.0
+        self.torque_limit = limit
+        self._tau = np.zeros(self.model.n_v)
+        self.time = 0.0
+        self.failed = False
+        self.reason = ""
+        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "substeps": 0}
+        self.step_log: list | None = None
+        self._last: dict[str, Any] = {}
+
+    # ------------------------------------------------------------------ characters
+    @classmethod
+    def load_character(cls, name: Any, client: Any, **kw: Any) -> Any:
+        """Load a character into ``client`` with a ``CharacterConfig``'s gain overrides applied.
+
+        For tools (``jt bench spd``) that need the built-in characters without a simulator.
+
+        Args:
+            name: a character name, or a ``character`` config node / ``CharacterConfig``.
+            client: PyBullet client id.
+            **kw: passed to the loader (``base_position``, ``self_collision`` ...).
+
+        Returns:
+            A ``jt_bullet.characters.Character`` (``kp``, ``kd``, ``torque_limit`` overridden).
+        """
+        from jt_bullet import characters, scene
+
+        cc = CharacterConfig.from_node(name)
+        ch = characters.load(cc.name, client, **kw)
+        if cc.kp is None and cc.kd is None and cc.torque_limit is None and not (
+                cc.joint_kp or cc.joint_kd or cc.joint_torque_limit):
+            return ch
+        base = 0 if ch.fixed_base else 6
+        for arr, value in ((ch.kp, cc.kp), (ch.kd, cc.kd), (ch.torque_limit, cc.torque_limit)):
+            if value is not None:
+                arr[base:] = float(value)
+        names = scene.joint_names(ch.client, ch.body_id)
+        slices, k = {}, base
+        for j, n in zip(ch.joint_indices, ch.joint_dofs):
+            slices[names[j]] = slice(k, k + n)
+            k += n
+        for arr, table in ((ch.kp, cc.joint_kp), (ch.kd, cc.joint_kd),
+                           (ch.torque_limit, cc.joint_torque_limit)):
+            for joint, value in table.items():
+                if joint not in slices:
+                    raise KeyError(f"character {cc.name!r} has no movable joint {joint!r}; "
+                                   f"joints: {', '.join(slices)}")
+                arr[slices[joint]] = float(value)
+        ch.gains_source += " (overridden by the character config)"
+        return ch
+
+    # ------------------------------------------------------------------ Simulator API
+    def reset(self, q: np.ndarray, qd: np.ndarray) -> None:
+        """Put the character in state ``(q, qd)`` (``toolkit.dynamics`` layout); time = 0."""
+        self.io.reset(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
+        self.time = 0.0
+        self.failed = False
+        self.reason = ""
+        self._tau[:] = 0.0
+        self._last = {}
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Current ``(q (n_q,), qd (n_dof,))`` (copies)."""
+        q, qd = self.io.read()
+        return q.copy(), qd.copy()
+
+    def step(self, q_target: np.ndarray, qd_target: np.ndarray | None = None) -> dict[str, Any]:
+        """One control step: ``n_substeps`` SPD-controlled substeps towards ``q_target``.
+
+        Args:
+            q_target: target positions ``(n_q,)``; the root part is read only with a root servo.
+            qd_target: target velocities ``(n_dof,)``; zero if None.
+
+        Returns:
+            The step record: ``time`` (s), ``q`` ``(n_q,)``, ``qd`` ``(n_dof,)``, ``tau``
+            ``(n_dof,)`` (last applied, clipped; NaN for ``spd=bullet``), ``contacts`` (bool
+            ``(n_links + 1,)``, index = PyBullet link + 1), ``n_contacts``, ``failed``, ``reason``.
+        """
+        if self.failed:
+            return dict(self._last, failed=True, reason=self.reason)
+        pb, kw, io, be = self._pb, self._kw, self.io, self.backend
+        qt = np.ascontiguousarray(q_target, dtype=float)
+        if qt.shape != (self.model.n_q,):
+            raise ValueError(f"q_target has shape {qt.shape}, expected ({self.model.n_q},)")
+        vt = None if qd_target is None else np.ascontiguousarray(qd_target, dtype=float)
+        kp, kd, lim, dt, tau = self.kp, self.kd, self.torque_limit, self.dt, self._tau
+        perf = time.perf_counter
+        spd_s = sub_s = 0.0
+        done = 0
+        for _ in range(self.n_substeps):
+            t0 = perf()
+            if self.steps_itself:
+                be.apply(qt, kp, kd, lim, vt)
+                ts = 0.0
+            else:
+                q, qd = io.read()
+                t1 = perf()
+                raw = be.torques(q, qd, qt, kp, kd, dt, vt)
+                ts = perf() - t1
+                np.clip(raw, -lim, lim, out=tau)
+                if not math.isfinite(float(tau.sum())):
+                    self._fail("non-finite SPD torques (NaN or exploding state)")
+                    break
+                io.write_torques(tau)
+            pb.stepSimulation(**kw)
+            dt_sub = perf() - t0
+            sub_s += dt_sub
+            spd_s += ts
+            done += 1
+            if self.step_log is not None:
+                self.step_log.append((ts, dt_sub))
+        self.timers["spd_s"] += spd_s
+        self.timers["substep_s"] += sub_s
+        self.timers["substeps"] += done
+        self.time += done * dt
+        q, qd = io.read()
+        if not self.failed:
+            self._check(q, qd)
+        rec = {"time": self.time, "q": q.copy(), "qd": qd.copy(),
+               "tau": np.full(self.model.n_v, np.nan) if self.steps_itself else tau.copy()}
+        if self.params.contacts:
+            touching, n = self._contacts()
+        else:
+            touching, n = np.zeros(self.n_links + 1, dtype=bool), 0
+        rec.update(contacts=touching, n_contacts=n, failed=self.failed, reason=self.reason)
+        self._last = rec
+        return rec
+
+    def render(self, width: int = 320, height: int = 240) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, the camera on the root."""
+        from jt_bullet.render import Camera, render_frame
+
+        d, yaw, pitch = DEFAULT_CAMERA.get(self.char_cfg.name, (3.0, 0.0, -10.0))
+        c = self.char_cfg
+        cam = Camera(distance=d if c.camera_distance is None else c.camera_distance,
+                     yaw=yaw if c.camera_yaw is None else c.camera_yaw,
+                     pitch=pitch if c.camera_pitch is None else c.camera_pitch)
+        pos, _ = self._pb.getBasePositionAndOrientation(self.character.body_id, **self._kw)
+        target = [v if math.isfinite(v) else 0.0 for v in pos]
+        return render_frame(self.client, target, width, height, cam)
+
+    def close(self) -> None:
+        """Disconnect the PyBullet client (idempotent)."""
+        if getattr(self, "client", None) is not None:
+            try:
+                self._pb.disconnect(**self._kw)
+            except Exception:  # noqa: BLE001 - already disconnected
+                pass
+            self.client = None
+
+    def __del__(self) -> None:  # pragma: no cover - best effort
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001
+            pass
+
+    # ------------------------------------------------------------------ helpers
+    @property
+    def spd_share(self) -> float:
+        """SPD solve time over whole-substep time so far (NaN for ``spd=bullet`` or no steps)."""
+        if self.steps_itself or self.timers["substep_s"] <= 0.0:
+            return math.nan
+        return self.timers["spd_s"] / self.timers["substep_s"]
+
+    def reset_timers(self) -> None:
+        """Zero the SPD / substep timers."""
+        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "substeps": 0}
+
+    def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
+        """World position ``(3,)`` and orientation x,y,z,w ``(4,)`` of a link's URDF frame
+        (-1: the base frame)."""
+        pb, b, kw = self._pb, self.character.body_id, self._kw
+        if link < 0:
+            pos, orn = pb.getBasePositionAndOrientation(b, **kw)
+        else:
+            s = pb.getLinkState(b, link, computeForwardKinematics=True, **kw)
+            pos, orn = s[4], s[5]
+        return np.array(pos), np.array(orn)
+
+    def _check(self, q: np.ndarray, qd: np.ndarray) -> None:
+        p = self.params
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+            self._fail("NaN state")
+            return
+        vmax = float(np.max(np.abs(qd))) if qd.size else 0.0
+        if vmax > p.explode_speed:
+            self._fail(f"exploded: |qd| = {vmax:.3g} > explode_speed = {p.explode_speed:g}")
+        elif not self.character.fixed_base and float(np.linalg.norm(q[:3])) > p.explode_distance:
+            self._fail(f"exploded: root {float(np.linalg.norm(q[:3])):.3g} m from the origin")
+
+    def _fail(self, reason: str) -> None:
+        self.failed = True
+        self.reason = reason
+
+    def _contacts(self) -> tuple[np.ndarray, int]:
+        from jt_bullet.scene import contact_summary
+
+        return contact_summary(self.client, self.character.body_id, self.n_links)
