@@ -1,0 +1,76 @@
+"""Benchmark: seconds per standing-jump evaluation (one simulation), and where the time goes.
+
+Run ``python -m jt_tasks.standing_jump.bench [--n 10] [--sim-hz 600]``. Speed is measured here,
+never in tests. Evaluations are the seed controller and seeded perturbations of it (successes and
+failures both count: a search evaluates both).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from typing import Any
+
+
+def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, seed: int = 0) -> dict[str, Any]:
+    """Wall and CPU seconds per evaluation over ``n`` evaluations.
+
+    Args:
+        n: evaluations (the first is the seed controller, the rest perturbations of it).
+        sim_hz: simulation rate.
+        sigma: perturbation size, as a fraction of each parameter's range.
+        seed: seed of the perturbations.
+
+    Returns:
+        ``{"wall_s": [...], "cpu_s": [...], "sim_s": [...], "success": [...], "median_wall_s": ...,
+        "median_cpu_s": ..., "realtime_factor": ...}``.
+    """
+    import numpy as np
+
+    from jt_tasks.standing_jump import params as P
+    from jt_tasks.standing_jump.simulate import SimSettings, simulate
+
+    sp = P.space()
+    rng = np.random.default_rng(seed)
+    st = SimSettings(sim_hz=sim_hz)
+    simulate(sp.to_dict(sp.defaults()), st)  # warm-up: imports, URDF cache
+    out: dict[str, list] = {"wall_s": [], "cpu_s": [], "sim_s": [], "success": []}
+    lo, hi = np.array(sp.lows), np.array(sp.highs)
+    for i in range(n):
+        x = np.array(sp.defaults())
+        if i:
+            x = np.clip(x + sigma * (hi - lo) * rng.normal(size=x.size), lo, hi)
+        w0, c0 = time.perf_counter(), time.process_time()
+        r = simulate(sp.to_dict(x), st)
+        out["wall_s"].append(time.perf_counter() - w0)
+        out["cpu_s"].append(time.process_time() - c0)
+        out["sim_s"].append(r.sim_time)
+        out["success"].append(r.success)
+    res: dict[str, Any] = dict(out)
+    res["median_wall_s"] = float(np.median(out["wall_s"]))
+    res["median_cpu_s"] = float(np.median(out["cpu_s"]))
+    res["realtime_factor"] = float(np.sum(out["sim_s"]) / np.sum(out["cpu_s"]))
+    res["sim_hz"] = sim_hz
+    res["machine"] = {"cpu": platform.processor() or platform.machine(), "python": platform.python_version()}
+    return res
+
+
+def main() -> None:  # pragma: no cover - command line
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=10)
+    ap.add_argument("--sim-hz", type=float, default=600.0)
+    ap.add_argument("--json", type=str, default="")
+    a = ap.parse_args()
+    res = time_evaluations(a.n, a.sim_hz)
+    print(f"{a.n} evaluations at {a.sim_hz:g} Hz: median wall {res['median_wall_s']:.3f} s, "
+          f"median CPU {res['median_cpu_s']:.3f} s, {res['realtime_factor']:.1f}x real time, "
+          f"{sum(res['success'])}/{a.n} successful")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(res, f, indent=2)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
