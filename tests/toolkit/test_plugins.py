@@ -16,7 +16,7 @@ EXPECTED_BUILTINS = {
     "action": {"raw", "pvae", "cvae", "ffc_fbc"},
     "reward": {"task_complete", "root_rotation", "safety", "naturalness", "novelty"},
     "curriculum": {"bar_height", "obstacle_width", "terrain"},
-    "task": {"strategy_landscape", "zdt1", "pose_prior", "spd_tracking", "standing_jump"},
+    "task": {"strategy_landscape", "zdt1", "pose_prior", "spd_tracking", "standing_jump", "highjump", "obstacle", "longjump"},
     "sim": {"bullet"},
 }
 

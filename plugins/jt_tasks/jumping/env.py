@@ -1,0 +1,309 @@
+"""The jump environment (``gymnasium.Env``): from a take-off state over a bar / obstacle onto a mat.
+
+One episode (``000`` §6.1): reset to the take-off state (``takeoff``) in front of the suite
+(``scene``); each ``step`` maps the action to PD targets (the action space plugin), then runs
+``round(sim_hz / control_hz)`` simulation substeps, checking contacts after each:
+
+* failure (terminated, reward = product of the terms = 0 through ``task_complete``): any body part
+  touches the wall / obstacle, any part other than the take-off foot touches the ground, the
+  simulator fails (NaN, exploding), or the jump has not succeeded ``time_limit`` s (2 s) after
+  take-off;
+* success (terminated): the character touches the mat with every part at least ``safe_margin``
+  (20 cm) from the wall / obstacle.
+
+The reward is sparse: 0 on every step but the last, where it is the product of the configured
+terms (``000`` eqs 2, 15, 16) on the episode record ``success``, ``root_ang_vel_mean`` (mean root
+angular speed over the control steps), ``head_first_landing`` (the neck/head link was among the
+first links to touch the mat), ``naturalness`` (the action space's ``penalty()`` averaged over the
+episode), ``feature`` and ``policy_features`` (Stage 2). Every term value is in the final ``info``
+as ``r_<term>``, with ``feature_angle`` (Stage-1 feature), ``crossed``, ``success``.
+
+The environment attributes ``bar_height`` / ``obstacle_width`` (rebuilds the suite at the next
+reset), ``control_hz`` and ``c_offset`` are what the curricula set (``set_wrapper_attr``).
+
+Observation ``(obs_dim,)`` float32, in the suite frame (normal, up, along): root height, root
+position relative to the feature plane (normal and along components), root orientation (6D),
+root linear and angular velocity, internal joint positions (quaternions / angles) and velocities,
+link centres of mass relative to the root, the difficulty value, time since take-off / limit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Optional
+
+import numpy as np
+import gymnasium
+from gymnasium import spaces
+
+from jt_tasks.jumping.features import CrossingTracker
+from jt_tasks.jumping.scene import Suite, SuiteSpec
+from jt_tasks.jumping.takeoff import FOOT_LINKS, takeoff_state
+
+HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index)
+
+
+@dataclasses.dataclass
+class EnvSpec:
+    """Everything an environment needs, as plain picklable data."""
+
+    kind: str = "highjump"  # highjump | obstacle
+    features: dict = dataclasses.field(default_factory=dict)  # take-off features by name
+    suite: SuiteSpec = dataclasses.field(default_factory=SuiteSpec)
+    clip: str = "run"  # reference run (000 §6.1.1; the DeepMimic run clip)
+    foot: str = "right"  # take-off foot
+    omega_y: Optional[float] = 3.0  # fixed facing-frame omega_y (000 §6.1.1), None: keep / explored
+    foot_clearance: float = 0.002  # m between the take-off foot and the ground at reset (ours)
+    time_limit: float = 2.0  # s after take-off (000 §6.1)
+    safe_margin: float = 0.2  # m from the wall for a success (000 §6.1)
+    control_hz: float = 10.0  # initial control rate (the curriculum changes it)
+    check_every: int = 1  # substeps between contact checks
+    sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
+    action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
+    reward_terms: dict = dataclasses.field(default_factory=dict)  # {term: params}
+    policy_features: list = dataclasses.field(default_factory=list)  # Stage 2: f_i of earlier policies
+
+
+class JumpEnv(gymnasium.Env):
+    """High / obstacle / long jump from a take-off state (000 §6.1), sparse product reward."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, spec: EnvSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
+        import pybullet as pb
+        from omegaconf import OmegaConf
+
+        from toolkit import plugins
+
+        super().__init__()
+        self.spec_ = spec
+        self.render_mode = render_mode
+        self._pb = pb
+        sim_cfg = OmegaConf.create(dict(spec.sim))
+        sim_cfg.sim = OmegaConf.merge(sim_cfg.get("sim") or {}, {"contacts": False})
+        sim_name = str((sim_cfg.sim.get("name") if "name" in sim_cfg.sim else None) or "bullet")
+        self.sim = plugins.load("sim", sim_name)(sim_cfg)
+        self.client = self.sim.client
+        self.body = self.sim.character.body_id
+        self.ground = int(getattr(self.sim, "ground_id", -1))
+        self.sim_hz = float(self.sim.params.sim_hz)
+        self.sim.n_substeps = 1
+        self.n_links = pb.getNumJoints(self.body, physicsClientId=self.client)
+        self.masses = np.array([pb.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
+                                for i in range(-1, self.n_links)])
+        self.foot_link = FOOT_LINKS[spec.foot]
+        act_cfg = OmegaConf.create(dict(spec.action))
+        self.action_space_ = plugins.load("action", str(act_cfg.name))(act_cfg, "humanoid")
+        self.skeleton = self.action_space_.skeleton
+        self.terms = {name: plugins.load("reward", name)(params)
+                      for name, params in (spec.reward_terms or {}).items()}
+        self.suite = Suite(self.client, spec.suite)
+        feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
+        self.takeoff = takeoff_state(feats, spec.clip, spec.foot, spec.omega_y)
+        self._q0, self._qd0 = self._place(self.takeoff.q, self.takeoff.qd)
+        self.control_hz = float(spec.control_hz)
+        self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)
+        self.tracker = CrossingTracker()
+        low, high = self.action_space_.bounds()
+        self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
+        self._reset_episode()
+        obs = self._obs()
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
+        if seed is not None:
+            self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
+
+    # ------------------------------------------------------------------ curriculum attributes
+    @property
+    def bar_height(self) -> float:
+        return float(self._pending["bar_height"])
+
+    @bar_height.setter
+    def bar_height(self, value: float) -> None:
+        self._pending["bar_height"] = float(value)
+
+    @property
+    def obstacle_width(self) -> float:
+        return float(self._pending["obstacle_width"])
+
+    @obstacle_width.setter
+    def obstacle_width(self, value: float) -> None:
+        self._pending["obstacle_width"] = float(value)
+
+    @property
+    def c_offset(self) -> float:
+        return float(getattr(self.action_space_, "c_offset", math.nan))
+
+    @c_offset.setter
+    def c_offset(self, value: float) -> None:
+        if hasattr(self.action_space_, "set_c_offset"):
+            self.action_space_.set_c_offset(float(value))
+
+    @property
+    def substeps(self) -> int:
+        """Simulation substeps per control step: ``round(sim_hz / control_hz)`` (at least 1)."""
+        return max(1, int(round(self.sim_hz / float(self.control_hz))))
+
+    @property
+    def difficulty(self) -> float:
+        """The curriculum's z: bar height (high jump) or obstacle width."""
+        s = self.suite.spec
+        return s.bar_height if s.kind == "highjump" else s.obstacle_width
+
+    # ------------------------------------------------------------------ helpers
+    def _place(self, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Lift/lower the state so that the take-off foot is ``foot_clearance`` above the ground."""
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        q = q.copy()
+        self.sim.reset(q, qd)
+        foot_min = pb.getAABB(self.body, self.foot_link, **kw)[0][1]
+        q[1] += self.spec_.foot_clearance - foot_min
+        return q, qd.copy()
+
+    def _com_and_links(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        pos, orn = pb.getBasePositionAndOrientation(self.body, **kw)
+        states = pb.getLinkStates(self.body, list(range(self.n_links)), **kw)
+        links = np.array([pos] + [s[0] for s in states])
+        com = self.masses @ links / self.masses.sum()
+        return com, links, np.array(orn)
+
+    def _reset_episode(self) -> None:
+        spec = self.suite.spec
+        if spec.kind == "highjump":
+            self.suite.update(bar_height=self._pending["bar_height"])
+        else:
+            self.suite.update(obstacle_width=self._pending["obstacle_width"])
+        self.sim.reset(self._q0, self._qd0)
+        self.action_space_.reset(None)
+        self.tracker.reset()
+        self.t = 0.0
+        self.done = False
+        self._ang_speeds: list[float] = []
+        self._penalties: list[float] = []
+        self.landed = False
+        self.head_first = False
+        com, _, orn = self._com_and_links()
+        self.tracker.update(0.0, float(self.suite.past(com)), orn)
+
+    def _obs(self) -> np.ndarray:
+        q, qd = self.sim.state()
+        com, links, orn = self._com_and_links()
+        R = self.suite.rotation()
+        root = q[:3]
+        from toolkit.motion.rotations import quat_to_matrix
+
+        m = R.T @ quat_to_matrix(q[3:7])
+        rel = (links[1:] - root) @ R
+        parts = [
+            [root[1], float(self.suite.past(root)), float(root @ self.suite.along)],
+            m[:, :2].T.reshape(-1), R.T @ qd[:3], R.T @ qd[3:6], q[7:], qd[6:], rel.reshape(-1),
+            [self.difficulty, self.t / self.spec_.time_limit],
+        ]
+        return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
+
+    def _contacts(self) -> tuple[bool, bool, set[int]]:
+        """``(wall touched, forbidden ground contact, links touching the mat)``."""
+        pts = self._pb.getContactPoints(bodyA=self.body, physicsClientId=self.client)
+        wall = ground = False
+        mat: set[int] = set()
+        for p in pts:
+            other, link = p[2], p[3]
+            if other == self.suite.barrier_id:
+                wall = True
+            elif other == self.ground and link != self.foot_link:
+                ground = True
+            elif other == self.suite.mat_id:
+                mat.add(int(link))
+        return wall, ground, mat
+
+    # ------------------------------------------------------------------ gymnasium API
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None) -> tuple[np.ndarray, dict]:
+        super().reset(seed=seed)
+        self._reset_episode()
+        return self._obs(), {}
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:
+        if self.done:
+            raise RuntimeError("step() after the episode ended; call reset()")
+        targets = self.action_space_.targets(np.asarray(action, dtype=np.float64))
+        self._penalties.append(float(self.action_space_.penalty()))
+        q, _ = self.sim.state()
+        q_target = np.concatenate([q[:7], self.skeleton.dofs_to_joints(targets)])
+        status, reason = "", ""
+        for k in range(self.substeps):
+            rec = self.sim.step(q_target)
+            self.t = float(self.sim.time)
+            if rec["failed"]:
+                status, reason = "fail", f"simulator: {rec['reason']}"
+                break
+            if (k + 1) % self.spec_.check_every and k + 1 < self.substeps:
+                continue
+            com, _, orn = self._com_and_links()
+            self.tracker.update(self.t, float(self.suite.past(com)), orn)
+            wall, ground, mat = self._contacts()
+            if wall:
+                status, reason = "fail", "touched the bar"
+                break
+            if ground:
+                status, reason = "fail", "touched the ground"
+                break
+            if mat:
+                if not self.landed:
+                    self.landed, self.head_first = True, HEAD_LINK in mat
+                if not self.suite.near_barrier(self.body, self.spec_.safe_margin):
+                    status = "success"
+                    break
+            if self.t >= self.spec_.time_limit - 1e-9:
+                status, reason = "fail", "time limit"
+                break
+        _, qd = self.sim.state()
+        self._ang_speeds.append(float(np.linalg.norm(qd[3:6])))
+        obs = self._obs()
+        if not status:
+            return obs, 0.0, False, False, {}
+        self.done = True
+        return obs, *self._finish(status == "success", reason)
+
+    def _finish(self, success: bool, reason: str) -> tuple[float, bool, bool, dict]:
+        record = self.episode_record(success)
+        values = {name: float(term(record)) for name, term in self.terms.items()}
+        reward = math.prod(values.values()) if values else float(success)
+        info: dict[str, Any] = {f"r_{k}": v for k, v in values.items()}
+        info.update(success=float(success), crossed=float(self.tracker.crossed),
+                    feature_angle=float(self.tracker.stage1()), bar_height=float(self.difficulty),
+                    naturalness=record["naturalness"], root_ang_vel_mean=record["root_ang_vel_mean"],
+                    head_first_landing=float(record["head_first_landing"]), episode_time=self.t,
+                    control_hz=float(self.control_hz), reason=reason or "success")
+        return float(reward), True, False, info
+
+    def episode_record(self, success: bool) -> dict[str, Any]:
+        """The end-of-episode record the reward terms read."""
+        return {
+            "success": bool(success),
+            "root_ang_vel_mean": float(np.mean(self._ang_speeds)) if self._ang_speeds else 0.0,
+            "head_first_landing": bool(self.head_first),
+            "naturalness": float(np.mean(self._penalties)) if self._penalties else 1.0,
+            "feature": self.tracker.stage2(self.suite.rotation()) if self.tracker.crossed else np.zeros(4),
+            "policy_features": np.asarray(self.spec_.policy_features, dtype=float).reshape(-1, 4)
+            if len(self.spec_.policy_features) else np.zeros((0, 4)),
+        }
+
+    def render(self) -> np.ndarray:
+        """RGB frame ``(240, 320, 3)`` uint8 (the simulator's camera on the root)."""
+        return self.sim.render(320, 240)
+
+    def close(self) -> None:
+        if getattr(self, "sim", None) is not None:
+            self.sim.close()
+            self.sim = None
+
+
+class EnvFactory:
+    """Picklable ``env_fn(seed) -> JumpEnv`` for PPO's rollout workers."""
+
+    def __init__(self, spec: EnvSpec) -> None:
+        self.spec = spec
+
+    def __call__(self, seed: int) -> JumpEnv:
+        return JumpEnv(self.spec, seed=seed)

@@ -1,0 +1,219 @@
+"""``task=highjump|obstacle|longjump``: one evaluation = train a jump policy from a take-off state.
+
+Stage 1 of ``000`` (§5.1, §6.1): the searcher (``search=bds``) explores the take-off features;
+each evaluation trains PPO (``cfg.agent``) with the action space (``cfg.action``, P-VAE by
+default), the product reward (``cfg.reward``) and the curriculum (``cfg.curriculum``) until
+``z_freeze`` or the sample budget, then measures the strategy feature of the deterministic policy:
+the angle between the root's up axis and world up when the CoM crosses the bar plane (``000``
+§6.1.4), range ``[0, pi]``. Stage 2 (``task.stage=2 task.init=...``): ``jt_tasks.jumping.stage2``.
+
+Groups left null fall back to this task's choices (``task.action``, ``task.reward``,
+``task.curriculum``, ``task.spd``), so ``jt run task=highjump`` works on the base config.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any, ClassVar, Optional
+
+from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.searcher import Param, SearchProblem, Space
+from toolkit.interfaces.task import EvalContext, Evaluation, Task
+
+FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
+
+
+def _group(cfg: Any, key: str) -> Any:
+    try:
+        return cfg[key] if key in cfg else None
+    except TypeError:
+        return getattr(cfg, key, None)
+
+
+def reward_terms_from_conf(name: str) -> dict:
+    """``terms`` of ``conf/reward/<name>.yaml`` (when the run config has no reward group)."""
+    from omegaconf import OmegaConf
+
+    from toolkit.config import conf_dir
+
+    return OmegaConf.to_container(OmegaConf.load(Path(conf_dir()) / "reward" / f"{name}.yaml"))["terms"]
+
+
+@dataclasses.dataclass
+class JumpConfig:
+    """Parameters shared by the jumping tasks (the ``task`` group)."""
+
+    name: str = "highjump"
+    stage: int = 1  # 1: take-off exploration (000 §5.1); 2: novel policy seeking (000 §5.2)
+    init: str = ""  # Stage 2: the Stage-1 evaluation to start from (its workdir or ppo.h5 path)
+    policy_features: list = dataclasses.field(default_factory=list)  # Stage 2: f_i (x,y,z,w) of earlier policies
+    point: dict = dataclasses.field(default_factory=dict)  # fixed take-off features overriding the searched ones
+    ranges: dict = dataclasses.field(default_factory=dict)  # {feature: [low, high]} (see the task YAML)
+    takeoff: dict = dataclasses.field(default_factory=dict)  # {feature: default value} (the searched point's defaults)
+    distance: float = 0.9  # m, take-off point to the bar plane / obstacle (ours)
+    obstacle_height: float = 0.5  # m (000 §6.1); 0 for the long jump
+    mat_height: float = 0.3  # m, rigid landing block (ours)
+    clip: str = "run"  # reference run clip (000 §6.1.1)
+    foot: str = "right"  # take-off foot (ours: the outer foot of a Fosbury with the bar on the left)
+    omega_y: Optional[float] = 3.0  # rad/s, fixed facing-frame omega_y of the high jump (000 §6.1.1)
+    time_limit: float = 2.0  # s (000 §6.1)
+    safe_margin: float = 0.2  # m (000 §6.1)
+    check_every: int = 1  # substeps between contact checks (1 = every 600 Hz substep)
+    action: str = "pvae"  # action space when cfg.action is null (000 §4.2)
+    reward: str = "highjump"  # conf/reward/<this>.yaml when cfg.reward is null (000 eqs 2, 16)
+    curriculum: str = "bar_height"  # curriculum when cfg.curriculum is null (000 §6.1.3)
+    spd: str = "df"  # SPD backend when cfg.spd is null (ours: dense SPD, fastest for 34 DoF)
+    distinct_threshold: float = 0.5  # rad: Stage-1 features closer than this are one strategy (ours)
+    filmstrip_frames: int = 8  # frames of the final jump
+    filmstrip_width: int = 160  # px per frame
+    filmstrip_height: int = 120  # px
+
+
+class JumpTask(Task):
+    """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
+
+    key_metrics: ClassVar[tuple[str, ...]] = ("strategy_angle", "bar_height_reached", "success_rate")
+    kind: ClassVar[str] = "highjump"
+    feature_names: ClassVar[tuple[str, ...]] = ("alpha", "omega_x", "omega_z", "v_z")
+    Config: ClassVar[type] = JumpConfig
+    RANGES: ClassVar[dict] = {}
+    DEFAULTS: ClassVar[dict] = {}
+
+    def __init__(self, cfg: Any = None) -> None:
+        super().__init__(cfg)
+        group = _group(cfg, "task") if cfg is not None else None
+        params = Plugin.params_of(group) if group is not None else {}
+        self.params = self.Config(**params)
+
+    # ------------------------------------------------------------------ search problem
+    def ranges(self) -> dict[str, tuple[float, float]]:
+        r = dict(self.RANGES)
+        r.update({k: (float(v[0]), float(v[1])) for k, v in (self.params.ranges or {}).items()})
+        return r
+
+    def problem(self) -> SearchProblem:
+        from jt_tasks.jumping.features import angle_distance
+
+        r, d = self.ranges(), {**self.DEFAULTS, **(self.params.takeoff or {})}
+        names = [n for n in self.feature_names if n not in (self.params.point or {})]
+        space = Space(tuple(Param(n, r[n][0], r[n][1], d.get(n)) for n in names))
+        return SearchProblem(space=space, n_features=1, feature_low=[0.0], feature_high=[math.pi],
+                             feature_distance=angle_distance, distinct_threshold=self.params.distinct_threshold)
+
+    # ------------------------------------------------------------------ building blocks
+    def env_spec(self, point: dict[str, float]) -> Any:
+        """The ``EnvSpec`` for take-off features ``point`` (missing ones: the defaults)."""
+        from omegaconf import OmegaConf
+
+        from jt_tasks.jumping.env import EnvSpec
+        from jt_tasks.jumping.scene import SuiteSpec
+
+        p, cfg = self.params, self.cfg
+        feats = {**self.DEFAULTS, **(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
+                 **{k: float(v) for k, v in (p.point or {}).items()}}
+        feats = {k: float(feats[k]) for k in self.feature_names}
+        suite = SuiteSpec(kind=self.kind, alpha=feats.get("alpha", 0.0), distance=p.distance,
+                          obstacle_height=p.obstacle_height, mat_height=p.mat_height)
+        plain = (lambda n: OmegaConf.to_container(n, resolve=True) if OmegaConf.is_config(n) else dict(n or {}))
+        sim = {"sim": plain(_group(cfg, "sim")), "spd": plain(_group(cfg, "spd")) or {"name": p.spd},
+               "character": plain(_group(cfg, "character")) or {"name": "humanoid"}}
+        action = plain(_group(cfg, "action")) or {"name": p.action}
+        reward = _group(cfg, "reward")
+        terms = plain(reward)["terms"] if reward is not None else reward_terms_from_conf(self.reward_name())
+        return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
+                       omega_y=p.omega_y if self.kind == "highjump" else None,
+                       time_limit=p.time_limit, safe_margin=p.safe_margin, check_every=p.check_every,
+                       sim=sim, action=action, reward_terms=terms,
+                       policy_features=[list(map(float, f)) for f in (p.policy_features or [])])
+
+    def reward_name(self) -> str:
+        return self.params.reward + ("_stage2" if self.params.stage == 2 else "")
+
+    def curriculum(self) -> Any:
+        from toolkit import plugins
+
+        node = _group(self.cfg, "curriculum")
+        name = str(node.name) if node is not None else self.params.curriculum
+        return plugins.load("curriculum", name)(node)
+
+    # ------------------------------------------------------------------ evaluation
+    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
+        from jt_tasks.jumping.train import run_evaluation
+
+        p = self.params
+        spec = self.env_spec(point)
+        if p.stage == 2:
+            from jt_tasks.jumping.stage2 import prepare
+
+            spec = prepare(spec, p, Path(ctx.workdir))
+        out = run_evaluation(spec, self.curriculum(), _group(self.cfg, "agent"), Path(ctx.workdir),
+                             ctx.seed, _group(self.cfg, "executor"), p.filmstrip_frames,
+                             (p.filmstrip_width, p.filmstrip_height), ctx.progress)
+        ro, res = out["rollout"], out["result"]
+        angle = float(ro["feature_angle"])
+        metrics = {
+            "strategy_angle": angle, "bar_height_reached": float(out["z"]),
+            "mean_return": float(ro["return"]),
+            "train_mean_return": _last(res.history.get("mean_return", [])),
+            "success_rate": out["succ"][-1] if out["succ"] else 0.0,
+            "final_success": float(ro["info"].get("success", 0.0)),
+            "samples": float(res.samples), "iterations": float(res.iterations),
+            "samples_per_s": out["samples_per_s"], "train_wall_s": float(out["wall_s"]),
+        }
+        metrics.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
+        metrics.update({f"feature_q{i}": float(v) for i, v in enumerate(ro["feature_quat"])})
+        arts = ["ppo.h5", "rollout.h5"] + (["filmstrip.png"] if (Path(ctx.workdir) / "filmstrip.png").exists() else [])
+        if not math.isfinite(angle):
+            return Evaluation(metrics={k: v for k, v in metrics.items() if math.isfinite(v)}, failed=True,
+                              reason="the deterministic jump never crossed the bar plane",
+                              history=out["history"], artifacts=arts)
+        return Evaluation(metrics=metrics, features=[angle], history=out["history"], artifacts=arts)
+
+
+def _last(values: list) -> float:
+    finite = [float(v) for v in values if math.isfinite(float(v))]
+    return finite[-1] if finite else 0.0
+
+
+class HighJumpTask(JumpTask):
+    """High jump (000 §6.1): explore (alpha, omega_x, omega_z, v_z) at take-off, feature = root up-angle at the bar."""
+
+    kind = "highjump"
+    feature_names = ("alpha", "omega_x", "omega_z", "v_z")
+    RANGES = {"alpha": (-0.5, 2.5), "omega_x": (-3.0, 3.0), "omega_z": (-3.0, 3.0), "v_z": (-2.5, -0.5)}
+    DEFAULTS = dict(FOSBURY)
+
+
+@dataclasses.dataclass
+class ObstacleConfig(JumpConfig):
+    """The obstacle jump's group (000 §6.1): the obstacle_width curriculum and reward."""
+
+    name: str = "obstacle"
+    reward: str = "obstacle"  # conf/reward/obstacle.yaml (000 §6.1.2)
+    curriculum: str = "obstacle_width"  # (000 §6.1.3, Table 1)
+
+
+class ObstacleTask(JumpTask):
+    """Obstacle jump (000 §6.1): explore the take-off root angular velocity, feature = up-angle at the centre plane."""
+
+    kind = "obstacle"
+    feature_names = ("omega_x", "omega_y", "omega_z")
+    Config = ObstacleConfig
+    RANGES = {"omega_x": (-3.0, 3.0), "omega_y": (-3.0, 3.0), "omega_z": (-3.0, 4.0)}
+    DEFAULTS = {"omega_x": 0.0, "omega_y": 0.0, "omega_z": 1.0}  # 000 Table 4, Straddle
+
+
+@dataclasses.dataclass
+class LongJumpConfig(ObstacleConfig):
+    """The long jump's group: an obstacle jump over an obstacle of height 0 (a gap before the mat)."""
+
+    name: str = "longjump"
+    obstacle_height: float = 0.0  # no box: jump the width onto the mat (jt variation)
+
+
+class LongJumpTask(ObstacleTask):
+    """Long jump: an obstacle jump with an obstacle of height 0 (clear the width, land on the mat)."""
+
+    Config = LongJumpConfig

@@ -1,0 +1,54 @@
+"""Strategy features on constructed crossings (000 §6.1.4)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from jt_tasks.jumping.features import CrossingTracker, angle_distance, suite_orientation, up_angle
+from toolkit.motion import rotations as rot
+
+
+def test_up_angle_of_known_orientations():
+    assert up_angle(np.array([0, 0, 0, 1.0])) == pytest.approx(0.0)
+    assert up_angle(rot.quat_from_axis_angle(np.array([1.0, 0, 0]), math.pi)) == pytest.approx(math.pi)
+    assert up_angle(rot.quat_from_axis_angle(np.array([0, 0, 1.0]), 0.7)) == pytest.approx(0.7)
+    # a turn about up does not change it
+    assert up_angle(rot.quat_from_axis_angle(np.array([0, 1.0, 0]), 2.0)) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_crossing_interpolates_the_orientation_at_the_plane():
+    tr = CrossingTracker()
+    q0 = np.array([0, 0, 0, 1.0])
+    q1 = rot.quat_from_axis_angle(np.array([1.0, 0, 0]), 1.0)
+    assert not tr.update(0.0, -0.3, q0)
+    assert not tr.update(0.1, -0.1, q0)
+    assert tr.update(0.2, 0.3, q1)  # zero crossing at 1/4 of the way from -0.1 to 0.3
+    assert tr.time == pytest.approx(0.125)
+    assert tr.stage1() == pytest.approx(0.25)
+    assert not tr.update(0.3, -0.1, q0) and tr.stage1() == pytest.approx(0.25)  # first crossing only
+
+
+def test_no_crossing_no_feature():
+    tr = CrossingTracker()
+    tr.update(0.0, -0.5, np.array([0, 0, 0, 1.0]))
+    tr.update(0.1, -0.2, np.array([0, 0, 0, 1.0]))
+    assert not tr.crossed and math.isnan(tr.stage1())
+    assert np.all(np.isnan(tr.stage2(np.eye(3))))
+
+
+def test_stage2_feature_is_independent_of_the_approach_angle():
+    # the same body pose relative to two suites turned by different approach angles
+    feats = []
+    for a in (0.0, 1.2):
+        R = rot.quat_to_matrix(rot.quat_from_axis_angle(np.array([0, 1.0, 0]), a))
+        q_world = rot.quat_multiply(rot.matrix_to_quat(R), rot.quat_from_axis_angle(np.array([1.0, 0, 0]), 0.4))
+        feats.append(suite_orientation(q_world, R))
+    np.testing.assert_allclose(feats[0], feats[1], atol=1e-9)
+
+
+def test_angle_distance():
+    assert angle_distance([0.2], [3.0]) == pytest.approx(2.8)
+    assert float(angle_distance([0.0], [math.pi])) == pytest.approx(math.pi)

@@ -1,0 +1,61 @@
+"""The task end to end: search problem, a tiny evaluation, its artifacts, resuming from ppo.h5."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+
+def _cfg(*extra):
+    from toolkit.config import compose
+
+    return compose(["task=highjump", "search=bds", "experiment=smoke", *extra])
+
+
+def test_problem_is_the_take_off_box_with_an_angle_feature():
+    from toolkit import plugins
+
+    task = plugins.load("task", "highjump")(_cfg())
+    pr = task.problem()
+    assert pr.space.names == ["alpha", "omega_x", "omega_z", "v_z"]
+    assert pr.space.defaults() == [-0.05, -3.0, 1.0, -2.40]  # Fosbury flop, 000 Table 3
+    assert pr.n_features == 1 and list(pr.feature_low) == [0.0] and list(pr.feature_high) == [math.pi]
+
+
+def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
+    from toolkit import plugins
+    from toolkit.interfaces.task import EvalContext
+    from toolkit.rl.checkpoint import load
+
+    task = plugins.load("task", "highjump")(_cfg())
+    ctx = EvalContext(index=0, seed=7, workdir=tmp_path)
+    ev = task.evaluate({"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.4}, ctx)
+    for name in ("ppo.h5", "rollout.h5", "filmstrip.png"):
+        assert (tmp_path / name).is_file(), name
+    assert ev.metrics["samples"] >= 128 and ev.metrics["bar_height_reached"] >= 0.5
+    assert "bar_height" in ev.history and len(ev.history["bar_height"]) == ev.metrics["iterations"]
+    assert ev.failed or 0.0 <= ev.features[0] <= math.pi
+    groups, _ = load(tmp_path / "ppo.h5")
+    assert groups["counters"]["samples"] == ev.metrics["samples"]
+    # a second call with the same workdir resumes: no new iteration, same policy, same history
+    w0 = groups["policy"]
+    ev2 = task.evaluate({"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.4}, ctx)
+    assert ev2.metrics["samples"] == ev.metrics["samples"]
+    assert ev2.metrics["iterations"] == ev.metrics["iterations"]
+    assert ev2.history["bar_height"] == ev.history["bar_height"]
+    g2, _ = load(tmp_path / "ppo.h5")
+    for k in w0:
+        np.testing.assert_array_equal(np.asarray(w0[k]), np.asarray(g2["policy"][k]))
+    assert ev2.metrics.get("strategy_angle", math.nan) == pytest.approx(ev.metrics.get("strategy_angle", math.nan), nan_ok=True)
+
+
+def test_stage2_says_it_is_not_implemented(tmp_path):
+    from toolkit import plugins
+    from toolkit.errors import JtError
+    from toolkit.interfaces.task import EvalContext
+
+    task = plugins.load("task", "highjump")(_cfg("task.stage=2"))
+    with pytest.raises(JtError, match="not implemented"):
+        task.evaluate({}, EvalContext(index=0, seed=0, workdir=tmp_path))
