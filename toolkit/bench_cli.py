@@ -102,3 +102,25 @@ def _plot(rows: list[dict], path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+@bench_app.command("ppo")
+def bench_ppo(
+    env: str = typer.Option("Pendulum-v1", "--env", help="Gymnasium id with a Box action space."),
+    samples: int = typer.Option(200_000, "--samples", help="Sample budget."),
+    seed: int = typer.Option(0, "--seed"),
+    target: float = typer.Option(-400.0, "--target", help="Return the final policy must reach."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the curve as JSON here."),
+) -> None:
+    """PPO sanity benchmark: a small standard control task must reach a known return (docs/ppo.md)."""
+    from toolkit.rl.sanity import run_sanity
+
+    res = run_sanity(env_id=env, total_samples=samples, seed=seed, verbose=True)
+    ok = res["final_return"] >= target
+    typer.echo(f"{env}: final return {res['final_return']:.1f} after {res['samples']} samples "
+               f"in {res['seconds']:.0f}s (target {target}): {'PASS' if ok else 'FAIL'}")
+    if json_out:
+        json_out.parent.mkdir(parents=True, exist_ok=True)
+        json_out.write_text(json.dumps({"machine": machine_info(), **res}, indent=2, default=float))
+    if not ok:
+        raise typer.Exit(1)
