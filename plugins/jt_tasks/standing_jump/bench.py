@@ -1,6 +1,6 @@
 """Benchmark: seconds per standing-jump evaluation (one simulation), and where the time goes.
 
-Run ``python -m jt_tasks.standing_jump.bench [--n 10] [--sim-hz 600]``. Speed is measured here,
+Run ``python -m jt_tasks.standing_jump.bench [--n 10] [--sim-hz 600] [--spd maba]``. Speed is measured here,
 never in tests. Evaluations are the seed controller and seeded perturbations of it (successes and
 failures both count: a search evaluates both).
 """
@@ -14,7 +14,8 @@ import time
 from typing import Any
 
 
-def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, seed: int = 0) -> dict[str, Any]:
+def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, seed: int = 0,
+                     spd: str = "maba") -> dict[str, Any]:
     """Wall and CPU seconds per evaluation over ``n`` evaluations.
 
     Args:
@@ -22,6 +23,7 @@ def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, se
         sim_hz: simulation rate.
         sigma: perturbation size, as a fraction of each parameter's range.
         seed: seed of the perturbations.
+        spd: SPD backend (maba, df, sf, pcg).
 
     Returns:
         ``{"wall_s": [...], "cpu_s": [...], "sim_s": [...], "success": [...], "median_wall_s": ...,
@@ -34,7 +36,7 @@ def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, se
 
     sp = P.space()
     rng = np.random.default_rng(seed)
-    st = SimSettings(sim_hz=sim_hz)
+    st = SimSettings(sim_hz=sim_hz, spd={"name": spd})
     simulate(sp.to_dict(sp.defaults()), st)  # warm-up: imports, URDF cache
     out: dict[str, list] = {"wall_s": [], "cpu_s": [], "sim_s": [], "success": []}
     lo, hi = np.array(sp.lows), np.array(sp.highs)
@@ -53,6 +55,7 @@ def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, se
     res["median_cpu_s"] = float(np.median(out["cpu_s"]))
     res["realtime_factor"] = float(np.sum(out["sim_s"]) / np.sum(out["cpu_s"]))
     res["sim_hz"] = sim_hz
+    res["spd"] = spd
     res["machine"] = {"cpu": platform.processor() or platform.machine(), "python": platform.python_version()}
     return res
 
@@ -61,10 +64,11 @@ def main() -> None:  # pragma: no cover - command line
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=10)
     ap.add_argument("--sim-hz", type=float, default=600.0)
+    ap.add_argument("--spd", type=str, default="maba", help="SPD backend: maba, df, sf or pcg")
     ap.add_argument("--json", type=str, default="")
     a = ap.parse_args()
-    res = time_evaluations(a.n, a.sim_hz)
-    print(f"{a.n} evaluations at {a.sim_hz:g} Hz: median wall {res['median_wall_s']:.3f} s, "
+    res = time_evaluations(a.n, a.sim_hz, spd=a.spd)
+    print(f"{a.n} evaluations at {a.sim_hz:g} Hz, spd={a.spd}: median wall {res['median_wall_s']:.3f} s, "
           f"median CPU {res['median_cpu_s']:.3f} s, {res['realtime_factor']:.1f}x real time, "
           f"{sum(res['success'])}/{a.n} successful")
     if a.json:

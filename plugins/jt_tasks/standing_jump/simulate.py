@@ -3,7 +3,9 @@
 PyBullet runs in its own DIRECT client per call (nothing shared between evaluations, so the same
 parameters give the same result). The default joint motors are disabled and the controller's
 torques are applied with ``TORQUE_CONTROL`` at every simulation step (``sim_hz``, 600 Hz by
-default). The supernatural assist of ``004`` §3.3 is reduced gravity after take-off, ramping back
+default). The PD targets become torques by Stable PD, solved by one of jt's SPD backends
+(``spd=maba|df|sf|pcg``, loaded through the plugin registry) on ``Model.from_bullet`` of the
+body. The supernatural assist of ``004`` §3.3 is reduced gravity after take-off, ramping back
 to -9.8 m/s² over the assist duration; it is applied with ``setGravity`` only while it differs
 from normal gravity, so a natural controller runs with exactly zero external force.
 """
@@ -38,6 +40,9 @@ class SimSettings:
         assist_deadzone: assists below this many m/s² are no assist (exact natural case).
         stable_pd: Stable PD torques (implicit damping); False: explicit PD (unstable at 1 kHz with
             the default gains, kept for comparison).
+        spd: the run's ``spd`` group as a plain dict (``{"name": "maba"}``: registry name of the
+            SPD backend and its parameters); any of maba, df, sf, pcg (``bullet`` cannot serve:
+            it never returns torques, and the controller adds torques after the solve).
     """
 
     sim_hz: float = 600.0
@@ -51,6 +56,7 @@ class SimSettings:
     landing_tolerance: float = 0.25
     assist_deadzone: float = 0.05
     stable_pd: bool = True
+    spd: dict = dataclasses.field(default_factory=lambda: {"name": "maba"})
 
 
 @dataclasses.dataclass
@@ -162,6 +168,33 @@ def simulate(point: dict[str, float], settings: Optional[SimSettings] = None, re
         p.disconnect(cid)
 
 
+def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
+    """A bound jt SPD backend for the PyBullet body, from the registry (``jt.spd``).
+
+    Args:
+        spd: the ``spd`` group (dict or config node; ``name`` picks the backend), or None for maba.
+        client: PyBullet client id.
+        body: body id.
+
+    Returns:
+        ``(backend, model)``: the backend bound to ``Model.from_bullet(client, body)`` (fixed base,
+        then the three root joints and the 16 hinges in PyBullet joint order), and that model.
+    """
+    from toolkit import plugins
+    from toolkit.dynamics.model import Model
+    from toolkit.interfaces.plugin import Plugin
+
+    name = str(spd["name"]) if spd is not None and "name" in spd else "maba"
+    backend = plugins.load("spd", name)({"name": name, **Plugin.params_of(spd)})
+    if getattr(backend, "steps_itself", False):
+        raise ValueError(f"spd={name} computes its torques inside stepSimulation; standing_jump "
+                         "needs the torques (it adds the virtual-force torques and applies "
+                         "limits): use maba, df, sf or pcg")
+    model = Model.from_bullet(client, body)
+    backend.bind(model)
+    return backend, model
+
+
 class _Episode:
     """The simulation loop of one jump and what it measures."""
 
@@ -177,11 +210,16 @@ class _Episode:
         weights = effort_weights(body)
         self.w = [weights[link.joint] for link in body.links[1:]]
         self.head = body.links.index(body.link("head"))
-        self.spd = None
+        self.spd: Any = None  # a bound jt SPD backend (None: explicit PD)
+        self.model: Any = None  # its toolkit.dynamics Model
         if st.stable_pd:
-            from jt_tasks.standing_jump.spd import StablePD
+            self.spd, self.model = spd_backend(st.spd, cid, robot)
 
-            self.spd = StablePD(cid, robot, self.n, 1.0 / st.sim_hz)
+    def set_gravity(self, g: float) -> None:
+        """Vertical gravity ``g`` (m/s²) for PyBullet and for the SPD model's bias forces."""
+        self.p.setGravity(0.0, 0.0, g, physicsClientId=self.cid)
+        if self.spd is not None:
+            self.model.gravity[:] = (0.0, 0.0, g)  # the kernels read this array on every solve
 
     def contacts(self) -> dict[int, float]:
         """``{link index: total normal force}`` of the character's links touching the ground."""
@@ -199,10 +237,11 @@ class _Episode:
         cmd = self.ctrl.command(fr, contacts, dt)
         if self.spd is None:
             tau = self.ctrl.pd(fr, cmd)
-        else:
+        else:  # the root's three DoFs keep zero gains: unactuated
             full = np.zeros((5, self.n))
             full[:, self.jidx] = [cmd.target, cmd.rate, cmd.kp, cmd.kd, cmd.extra]
-            tau_full = self.spd.torques(q, qd, full[0], full[1], full[2], full[3]) + full[4]
+            tau_full = self.spd.torques(np.asarray(q), np.asarray(qd), full[0], full[2], full[3], dt,
+                                        qd_target=full[1]) + full[4]
             tau = [float(v) for v in tau_full[self.jidx]]
         return self.ctrl.finish(tau, fr, contacts)
 
@@ -272,9 +311,9 @@ class _Episode:
                 if g != P.NATURAL_GRAVITY:
                     f = body.mass * (g - P.NATURAL_GRAVITY)  # the external force equivalent to the reduced gravity
                     e_se += f * f * dt
-                p.setGravity(0.0, 0.0, g, physicsClientId=cid)
+                self.set_gravity(g)
             elif t_land is not None and t_assist > 0.0:
-                p.setGravity(0.0, 0.0, P.NATURAL_GRAVITY, physicsClientId=cid)
+                self.set_gravity(P.NATURAL_GRAVITY)
             p.setJointMotorControlArray(robot, all_j, p.TORQUE_CONTROL, forces=forces, physicsClientId=cid)
             p.stepSimulation(physicsClientId=cid)
         else:

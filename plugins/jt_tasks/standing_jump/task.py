@@ -33,6 +33,20 @@ def _config(config_cls: type, cfg: Any) -> Any:
     return config_cls(**Plugin.params_of(group))
 
 
+def _spd_group(cfg: Any) -> dict:
+    """The run config's ``spd`` group as a plain dict; ``{"name": "maba"}`` when it has none."""
+    group = None
+    if cfg is not None:
+        try:
+            group = cfg["spd"] if "spd" in cfg else None
+        except TypeError:
+            group = getattr(cfg, "spd", None)
+    if group is None:
+        return {"name": "maba"}
+    name = str(group["name"]) if "name" in group else "maba"
+    return {"name": name, **Plugin.params_of(group)}
+
+
 class StandingJumpTask(Task):
     """Standing jump of a planar humanoid: jump height vs effort, natural and supernatural (004)."""
 
@@ -65,6 +79,7 @@ class StandingJumpTask(Task):
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         self.params = _config(self.Config, cfg)
+        self.spd = _spd_group(cfg)  # SPD backend (spd=maba|df|sf|pcg), maba without an spd group
 
     # ---- the search problem -------------------------------------------------------------------
     def settings(self) -> Any:
@@ -76,7 +91,8 @@ class StandingJumpTask(Task):
         return SimSettings(sim_hz=c.sim_hz, mass=c.mass, height=c.height, friction=c.friction,
                            timing=Timing(gains_scale=c.gains_scale), max_time=c.max_time,
                            upright_fraction=c.upright_fraction, landing_target=c.landing_target,
-                           landing_tolerance=c.landing_tolerance, assist_deadzone=c.assist_deadzone)
+                           landing_tolerance=c.landing_tolerance, assist_deadzone=c.assist_deadzone,
+                           spd=dict(self.spd))
 
     def reference_point(self) -> list[float]:
         """Hypervolume reference: standing head height (no jump) and an unreachable effort."""
