@@ -37,7 +37,7 @@ import numpy as np
 import gymnasium
 from gymnasium import spaces
 
-from jt_tasks.jumping.features import CrossingTracker
+from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
 from jt_tasks.jumping.takeoff import FOOT_LINKS, takeoff_state
 
@@ -284,7 +284,10 @@ class JumpEnv(gymnasium.Env):
             "root_ang_vel_mean": float(np.mean(self._ang_speeds)) if self._ang_speeds else 0.0,
             "head_first_landing": bool(self.head_first),
             "naturalness": float(np.mean(self._penalties)) if self._penalties else 1.0,
-            "feature": self.tracker.stage2(self.suite.rotation()) if self.tracker.crossed else np.zeros(4),
+            # not crossed: the root orientation now (the closest approach so far), finite as the
+            # novelty term needs (a zero quaternion made r_novelty NaN; the product is 0 anyway)
+            "feature": self.tracker.stage2(self.suite.rotation()) if self.tracker.crossed
+            else suite_orientation(self._com_and_links()[2], self.suite.rotation()),
             "policy_features": np.asarray(self.spec_.policy_features, dtype=float).reshape(-1, 4)
             if len(self.spec_.policy_features) else np.zeros((0, 4)),
         }

@@ -1,22 +1,290 @@
-"""Stage 2, novel policy seeking (``000`` §5.2): NOT IMPLEMENTED YET.
+"""Stage 2, novel policy seeking (``000`` §5.2, eqs 12 and 15; thesis ``001`` §3.5.2).
 
-The plan: ``task.stage=2 task.init=<Stage-1 evaluation folder>`` reads the take-off features from
-its ``rollout.h5``, warm-starts PPO from its ``ppo.h5`` (weights only, counters reset), and trains
-with ``reward=highjump_stage2`` whose ``novelty`` term (``000`` eq 12) compares each episode's
-root orientation at the bar (``JumpEnv.episode_record()["feature"]``, quaternion in the suite frame)
-with ``task.policy_features``. The environment already records that feature and passes
-``policy_features``; what is missing is the warm start and the run-id lookup.
+``jt run task=highjump task.stage=2 task.init=RUN_ID`` trains ONE new policy (``search=single``)
+from the take-off state of a Stage-1 evaluation, warm-started from that evaluation's policy
+(``000`` §7.1.1: "Training is warm started with the associated Stage 1 policy"), with the reward
+``r_task · r_naturalness · r_novelty`` (``conf/reward/highjump_stage2.yaml``). The novelty term
+(eq 12, ``d_threshold = π/2``, rotation-angle distance) compares each episode's root orientation at
+the bar plane (``000`` §6.1.4, quaternion x,y,z,w in the suite frame, ``w >= 0``) with the set Π of
+policies found so far.
+
+``task.init`` names (``resolve``):
+
+* a nested evaluation run of a Stage-1 search: that evaluation;
+* an outer Stage-1 run: its evaluation ``task.init_eval`` (``jt.eval_index``), or, with
+  ``init_eval = -1``, the best one: not failed first, then ``final_success``, ``bar_height_reached``,
+  ``mean_return`` (higher is better), then the lower index;
+* a run of ``search=single`` (the evaluation is logged on the run itself);
+* a folder holding ``ppo.h5`` and ``rollout.h5`` (or the ``ppo.h5`` itself).
+
+From it: the take-off state (the evaluation's ``takeoff_*`` metrics, else its params) and the
+policy ``ppo.h5`` artifact. Π = the evaluation's own feature (``feature_q0..3``, if its jump crossed
+the plane) + the features of the FINISHED Stage-2 runs in the store whose ``task.init`` resolves to
+the same evaluation (found through their logged params ``task.stage``, ``task.init``,
+``task.init_eval``) + ``task.policy_features``. Running the command again therefore adds one policy
+per run, as the paper's "five DRL iterations from each good initial state" (``000`` §7.1.1).
+
+Warm start (``write_warm_start``): the Stage-2 ``ppo.h5`` starts as a copy of the Stage-1 policy,
+value network and observation normaliser (with its running statistics), with a FRESH optimiser,
+counters at 0 and the seeded RNGs of a fresh run; the network sizes are taken from the Stage-1
+checkpoint. PPO then "resumes" from it, so a killed Stage-2 evaluation also resumes. The
+curriculum starts afresh (the paper does not say; ours).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
+import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
+
+_WARNED: set = set()  # sources already warned about in this process
+FEATURE_KEYS = tuple(f"feature_q{i}" for i in range(4))  #: metrics holding the Stage-2 feature
 
 
-def prepare(spec: Any, params: Any, workdir: Path) -> Any:
-    """Stage-2 set-up of an evaluation (not implemented: raises a one-line ``JtError``)."""
+@dataclasses.dataclass
+class Stage2Init:
+    """What ``task.init`` resolved to.
+
+    Attributes:
+        source: canonical name of the evaluation (its run id, or the resolved folder).
+        run_id: the run holding the policy (``""`` for a folder).
+        eval_index: its ``jt.eval_index`` (-1 when not a nested evaluation).
+        checkpoint: the Stage-1 ``ppo.h5``.
+        features: take-off state ``{name: value}``.
+        policy_features: Π, ``(n, 4)`` as lists (x, y, z, w).
+        previous_runs: ids of the earlier Stage-2 runs whose features are in Π.
+    """
+
+    source: str
+    run_id: str
+    eval_index: int
+    checkpoint: Path
+    features: dict
+    policy_features: list
+    previous_runs: list
+
+
+def _err(msg: str) -> Exception:
     from toolkit.errors import JtError
 
-    raise JtError("task.stage=2 (novel policy seeking, 000 §5.2) is not implemented yet; "
-                  "run Stage 1 (task.stage=1)")
+    return JtError(msg)
+
+
+def _is_path(init: str) -> bool:
+    return "/" in init or init.endswith(".h5") or Path(init).expanduser().exists()
+
+
+def _feature(metrics: dict) -> Optional[list]:
+    """``feature_q0..3`` of a run's metrics, None when absent (the jump never crossed the plane)."""
+    if not all(k in metrics and math.isfinite(float(metrics[k])) for k in FEATURE_KEYS):
+        return None
+    return [float(metrics[k]) for k in FEATURE_KEYS]
+
+
+def _pick(store: Any, run: Any, init_eval: int) -> Any:
+    """The evaluation run of ``run``: itself, or its nested child ``init_eval`` / the best one."""
+    if "mlflow.parentRunId" in run.data.tags:
+        return run
+    rid = run.info.run_id
+    kids = store.client.search_runs([run.info.experiment_id],
+                                    filter_string=f"tags.mlflow.parentRunId = '{rid}'", max_results=10000)
+    kids = [k for k in kids if "jt.eval_index" in k.data.tags]
+    if not kids:
+        if init_eval >= 0:
+            raise _err(f"task.init_eval={init_eval}: run {rid} has no nested evaluations")
+        return run
+    by_index = {int(k.data.tags["jt.eval_index"]): k for k in kids}
+    if init_eval >= 0:
+        if init_eval not in by_index:
+            raise _err(f"task.init_eval={init_eval}: run {rid} has evaluations {sorted(by_index)}")
+        return by_index[init_eval]
+
+    def rank(i: int) -> tuple:
+        m = by_index[i].data.metrics
+        return (-(m.get("failed", 1.0) == 0.0), -m.get("final_success", 0.0),
+                -m.get("bar_height_reached", 0.0), -m.get("mean_return", 0.0), i)
+
+    return by_index[min(by_index, key=rank)]
+
+
+def _source(store: Any, init: str, init_eval: int) -> tuple[Any, str]:
+    """``(evaluation run or None, canonical source)`` of ``task.init`` / ``task.init_eval``."""
+    if _is_path(init):
+        p = Path(init).expanduser().resolve()
+        return None, str(p.parent if p.suffix == ".h5" else p)
+    ev = _pick(store, store.get_run(init), init_eval)
+    return ev, ev.info.run_id
+
+
+def _previous_stage2(store: Any, experiment: str, source: str) -> list[tuple[str, list]]:
+    """``(run id, feature)`` of the FINISHED Stage-2 runs of ``experiment`` started from ``source``."""
+    exp = store.client.get_experiment_by_name(experiment)
+    if exp is None:
+        return []
+    runs = store.client.search_runs([exp.experiment_id], max_results=10000,
+                                    filter_string="params.`task.stage` = '2' and attributes.status = 'FINISHED'")
+    out = []
+    for r in sorted(runs, key=lambda r: r.info.start_time):
+        init = r.data.params.get("task.init", "")
+        try:
+            _, src = _source(store, init, int(r.data.params.get("task.init_eval", -1)))
+        except Exception:  # noqa: BLE001 - its init is gone or unreadable: not ours
+            continue
+        f = _feature(r.data.metrics)
+        if src == source and f is not None:
+            out.append((r.info.run_id, f))
+    return out
+
+
+def resolve(params: Any, store_path: str, experiment: str, feature_names: tuple) -> Stage2Init:
+    """Resolve ``task.init`` (see the module docstring); every problem is a one-line ``JtError``.
+
+    Args:
+        params: the task's ``JumpConfig`` (``stage``, ``init``, ``init_eval``, ``policy_features``).
+        store_path: the run's ``store``.
+        experiment: the experiment the Stage-2 runs are logged in (the task name).
+        feature_names: take-off features of the task.
+    """
+    from toolkit.store import h5
+    from toolkit.store.tracking import Store, store_root
+
+    init = str(params.init or "").strip()
+    if not init:
+        raise _err("task.stage=2 needs task.init=<RUN_ID of a Stage-1 run or evaluation> (000 §5.2)")
+    store = Store(store_root(store_path))
+    ev, source = _source(store, init, int(params.init_eval))
+    own: Optional[list] = None
+    if ev is None:  # a folder
+        folder = Path(source)
+        ckpt, ro = folder / "ppo.h5", folder / "rollout.h5"
+        if not ckpt.is_file() or not ro.is_file():
+            raise _err(f"task.init={init}: needs ppo.h5 and rollout.h5 in {folder}")
+        import ast
+
+        data, attrs = h5.read(ro), h5.read_attrs(ro)
+        raw = attrs.get("features", "{}")
+        feats = {k: float(v) for k, v in (ast.literal_eval(raw) if isinstance(raw, str) else {}).items()}
+        q = [float(x) for x in data.get("feature_quat", [])]
+        own = q if len(q) == 4 and all(math.isfinite(x) for x in q) else None
+        run_id, index = "", -1
+    else:
+        run_id, m = ev.info.run_id, ev.data.metrics
+        if ev.data.params.get("task.stage", "1") == "2":
+            raise _err(f"task.init={init} is a Stage-2 run; start from its Stage-1 init "
+                       f"{ev.data.params.get('task.init', '?')}")
+        ckpt = store.artifact_dir(run_id) / "ppo.h5"
+        if not ckpt.is_file():
+            raise _err(f"task.init={init}: run {run_id} has no trained policy (no ppo.h5 artifact); "
+                       "give a Stage-1 jumping run or evaluation")
+        feats = {k: float(m[f"takeoff_{k}"]) for k in feature_names if f"takeoff_{k}" in m}
+        for k in feature_names:  # nested evaluations also carry their point as params
+            if k not in feats and k in ev.data.params:
+                feats[k] = float(ev.data.params[k])
+        own = _feature(m)
+        index = int(ev.data.tags.get("jt.eval_index", -1))
+    missing = [k for k in feature_names if k not in feats]
+    if missing:
+        raise _err(f"task.init={init}: no take-off {', '.join(missing)} recorded (not a {experiment} run?)")
+    prev = _previous_stage2(store, experiment, source)
+    pi = ([own] if own is not None else []) + [f for _, f in prev]
+    pi += [[float(x) for x in f] for f in (params.policy_features or [])]
+    if own is None and source not in _WARNED:
+        _WARNED.add(source)
+        print(f"jt: stage 2: the init policy's jump never crossed the bar plane (no feature); "
+              f"Π has {len(pi)} feature(s)", file=sys.stderr, flush=True)
+    return Stage2Init(source=source, run_id=run_id, eval_index=index, checkpoint=ckpt,
+                      features={k: feats[k] for k in feature_names}, policy_features=pi,
+                      previous_runs=[r for r, _ in prev])
+
+
+def check_reward(terms: dict) -> None:
+    """Stage 2 needs the ``novelty`` term (eq 15); one-line error otherwise."""
+    if "novelty" not in (terms or {}):
+        raise _err("task.stage=2: the reward has no 'novelty' term (000 eq 15); use reward=highjump_stage2 "
+                   "or leave the reward group unset")
+
+
+# ---------------------------------------------------------------------------- warm start
+def adopt_architecture(cfg: Any, init_ckpt: Path) -> Any:
+    """``cfg`` (a ``PPOConfig``) with the Stage-1 checkpoint's network sizes and action mapping."""
+    from toolkit.rl import checkpoint as ck
+
+    _, attrs = ck.load(init_ckpt)
+    c = attrs["config"]
+    new = dataclasses.replace(cfg, policy_hidden=tuple(int(v) for v in c["policy_hidden"]),
+                              value_hidden=tuple(int(v) for v in c["value_hidden"]),
+                              normalize_actions=bool(c["normalize_actions"]))
+    if (new.policy_hidden, new.value_hidden) != (tuple(cfg.policy_hidden), tuple(cfg.value_hidden)):
+        print(f"jt: stage 2: networks {list(new.policy_hidden)}/{list(new.value_hidden)} from the init policy",
+              file=sys.stderr, flush=True)
+    return new
+
+
+def write_warm_start(path: Path, init_ckpt: Path, cfg: Any, env_fn: Any, extra: dict) -> Path:
+    """Write ``path``: a PPO checkpoint that ``toolkit.rl.ppo.train`` resumes as a fresh run whose
+    policy, value network and observation normaliser are those of ``init_ckpt``.
+
+    Args:
+        path: the Stage-2 ``ppo.h5``.
+        init_ckpt: the Stage-1 ``ppo.h5``.
+        cfg: the Stage-2 ``PPOConfig`` (after ``adopt_architecture``).
+        env_fn: ``env_fn(seed)`` of the Stage-2 environments (probed for the dimensions).
+        extra: the trainer's ``extra`` (curriculum state) to start with.
+    """
+    import json
+
+    import numpy as np
+    import torch
+
+    from toolkit.rl import checkpoint as ck
+    from toolkit.rl import ppo
+    from toolkit.rl.networks import ActorCritic
+
+    groups, attrs = ck.load(init_ckpt)
+    obs_dim, act_dim, low, high = ppo._probe(env_fn, cfg.seed)
+    if (obs_dim, act_dim) != (int(attrs["obs_dim"]), int(attrs["act_dim"])):
+        raise _err(f"task.init: the Stage-1 policy has obs/action sizes {attrs['obs_dim']}/{attrs['act_dim']}, "
+                   f"this Stage-2 set-up {obs_dim}/{act_dim}; use Stage 1's action and character settings")
+    torch.manual_seed(cfg.seed)  # the RNG state a fresh run has after building its networks
+    model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions)
+    model.pi.load_state_dict(groups["policy"])
+    model.v.load_state_dict(groups["value"])
+    pi_opt = ppo._make_optimizer(model.pi.parameters(), cfg.policy_lr, cfg)
+    v_opt = ppo._make_optimizer(model.v.parameters(), cfg.value_lr, cfg)
+    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([cfg.seed, 3])))
+    n_envs = cfg.n_workers * cfg.envs_per_worker
+    return ck.save(path, {
+        "policy": groups["policy"], "value": groups["value"], "obs_norm": groups["obs_norm"],
+        "policy_optim": pi_opt.state_dict(), "value_optim": v_opt.state_dict(),
+        "counters": {"iteration": 0, "samples": 0},
+        "rng": {"numpy": json.dumps(rng.bit_generator.state), "torch": torch.get_rng_state(),
+                "seed": cfg.seed, "env_ids": np.arange(n_envs), "seed_offset": 0},
+        "history": {}, "env_attrs": {}, "extra": dict(extra),
+    }, {"config": cfg.to_dict(), "obs_dim": obs_dim, "act_dim": act_dim, "low": low, "high": high,
+        "warm_start": str(init_ckpt)})
+
+
+# ---------------------------------------------------------------------------- metrics
+def novelty_metrics(feature: Any, policy_features: list, terms: dict) -> dict[str, float]:
+    """Novelty of the final deterministic jump vs Π with the reward's own ``novelty`` term.
+
+    Returns ``novelty`` (eq 12's value) and ``novelty_distance`` (rad, min over Π) when the jump
+    crossed the plane and Π is not empty (an empty Π gives novelty 1, no distance), and always
+    ``novelty_set_size`` = |Π|.
+    """
+    import numpy as np
+
+    from toolkit import plugins
+
+    out = {"novelty_set_size": float(len(policy_features))}
+    f = np.asarray(feature, dtype=float).reshape(-1)
+    if f.size != 4 or not np.all(np.isfinite(f)):
+        return out
+    term = plugins.load("reward", "novelty")(terms["novelty"])
+    pi = np.asarray(policy_features, dtype=float).reshape(-1, 4)
+    out["novelty"] = float(term({"feature": f, "policy_features": pi}))
+    if len(pi):
+        out["novelty_distance"] = float(term.min_distance(f, pi))
+    return out

@@ -47,7 +47,8 @@ class JumpConfig:
 
     name: str = "highjump"
     stage: int = 1  # 1: take-off exploration (000 §5.1); 2: novel policy seeking (000 §5.2)
-    init: str = ""  # Stage 2: the Stage-1 evaluation to start from (its workdir or ppo.h5 path)
+    init: str = ""  # Stage 2: Stage-1 run id (outer run or nested evaluation), or its folder / ppo.h5
+    init_eval: int = -1  # Stage 2, outer init run: evaluation index to start from (-1: the best one)
     policy_features: list = dataclasses.field(default_factory=list)  # Stage 2: f_i (x,y,z,w) of earlier policies
     point: dict = dataclasses.field(default_factory=dict)  # fixed take-off features overriding the searched ones
     ranges: dict = dataclasses.field(default_factory=dict)  # {feature: [low, high]} (see the task YAML)
@@ -86,6 +87,31 @@ class JumpTask(Task):
         group = _group(cfg, "task") if cfg is not None else None
         params = Plugin.params_of(group) if group is not None else {}
         self.params = self.Config(**params)
+        self._stage2: Any = None
+
+    # ------------------------------------------------------------------ Stage 2 (000 §5.2)
+    def stage2_init(self) -> Any:
+        """``jt_tasks.jumping.stage2.Stage2Init`` of ``task.init`` (resolved once); None in Stage 1."""
+        from toolkit.errors import JtError
+
+        p = self.params
+        if p.stage not in (1, 2):
+            raise JtError(f"task.stage={p.stage}: 1 (take-off exploration) or 2 (novel policy seeking)")
+        if p.stage == 1:
+            if str(p.init or "").strip():
+                raise JtError("task.init is for Stage 2: add task.stage=2")
+            return None
+        if self._stage2 is None:
+            from jt_tasks.jumping.stage2 import resolve
+
+            store = _group(self.cfg, "store") if self.cfg is not None else None
+            self._stage2 = resolve(p, str(store) if store is not None else None, str(p.name), self.feature_names)
+        return self._stage2
+
+    def _fixed(self) -> dict:
+        """Take-off features not searched: ``task.point``, or in Stage 2 the init's take-off state."""
+        init = self.stage2_init()
+        return dict(init.features) if init is not None else dict(self.params.point or {})
 
     # ------------------------------------------------------------------ search problem
     def ranges(self) -> dict[str, tuple[float, float]]:
@@ -97,7 +123,13 @@ class JumpTask(Task):
         from jt_tasks.jumping.features import angle_distance
 
         r, d = self.ranges(), {**self.DEFAULTS, **(self.params.takeoff or {})}
-        names = [n for n in self.feature_names if n not in (self.params.point or {})]
+        if self.params.stage == 2:
+            search = _group(self.cfg, "search") if self.cfg is not None else None
+            if search is not None and str(_group(search, "name")) != "single":
+                from toolkit.errors import JtError
+
+                raise JtError("task.stage=2 trains one policy from task.init: use search=single (the default)")
+        names = [n for n in self.feature_names if n not in self._fixed()]
         space = Space(tuple(Param(n, r[n][0], r[n][1], d.get(n)) for n in names))
         return SearchProblem(space=space, n_features=1, feature_low=[0.0], feature_high=[math.pi],
                              feature_distance=angle_distance, distinct_threshold=self.params.distinct_threshold)
@@ -112,7 +144,7 @@ class JumpTask(Task):
 
         p, cfg = self.params, self.cfg
         feats = {**self.DEFAULTS, **(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
-                 **{k: float(v) for k, v in (p.point or {}).items()}}
+                 **{k: float(v) for k, v in self._fixed().items()}}
         feats = {k: float(feats[k]) for k in self.feature_names}
         suite = SuiteSpec(kind=self.kind, alpha=feats.get("alpha", 0.0), distance=p.distance,
                           obstacle_height=p.obstacle_height, mat_height=p.mat_height)
@@ -122,11 +154,13 @@ class JumpTask(Task):
         action = plain(_group(cfg, "action")) or {"name": p.action}
         reward = _group(cfg, "reward")
         terms = plain(reward)["terms"] if reward is not None else reward_terms_from_conf(self.reward_name())
+        init = self.stage2_init()
+        pol = init.policy_features if init is not None else (p.policy_features or [])
         return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
                        omega_y=p.omega_y if self.kind == "highjump" else None,
                        time_limit=p.time_limit, safe_margin=p.safe_margin, check_every=p.check_every,
                        sim=sim, action=action, reward_terms=terms,
-                       policy_features=[list(map(float, f)) for f in (p.policy_features or [])])
+                       policy_features=[list(map(float, f)) for f in pol])
 
     def reward_name(self) -> str:
         return self.params.reward + ("_stage2" if self.params.stage == 2 else "")
@@ -144,13 +178,15 @@ class JumpTask(Task):
 
         p = self.params
         spec = self.env_spec(point)
-        if p.stage == 2:
-            from jt_tasks.jumping.stage2 import prepare
+        init = self.stage2_init()
+        if init is not None:
+            from jt_tasks.jumping.stage2 import check_reward
 
-            spec = prepare(spec, p, Path(ctx.workdir))
+            check_reward(spec.reward_terms)
         out = run_evaluation(spec, self.curriculum(), _group(self.cfg, "agent"), Path(ctx.workdir),
                              ctx.seed, _group(self.cfg, "executor"), p.filmstrip_frames,
-                             (p.filmstrip_width, p.filmstrip_height), ctx.progress)
+                             (p.filmstrip_width, p.filmstrip_height), ctx.progress,
+                             warm_start=init.checkpoint if init is not None else None)
         ro, res = out["rollout"], out["result"]
         angle = float(ro["feature_angle"])
         metrics = {
@@ -164,6 +200,11 @@ class JumpTask(Task):
         }
         metrics.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
         metrics.update({f"feature_q{i}": float(v) for i, v in enumerate(ro["feature_quat"])})
+        if init is not None:
+            from jt_tasks.jumping.stage2 import novelty_metrics
+
+            metrics.update(novelty_metrics(ro["feature_quat"], spec.policy_features, spec.reward_terms))
+            metrics["init_eval_index"] = float(init.eval_index)
         arts = ["ppo.h5", "rollout.h5"] + (["filmstrip.png"] if (Path(ctx.workdir) / "filmstrip.png").exists() else [])
         if not math.isfinite(angle):
             return Evaluation(metrics={k: v for k, v in metrics.items() if math.isfinite(v)}, failed=True,

@@ -78,7 +78,7 @@ def save_filmstrip(path: Path, frames: list) -> None:
 
 def run_evaluation(spec: Any, cur: Any, agent_cfg: Any, workdir: Path, seed: int,
                    executor_cfg: Any = None, filmstrip_frames: int = 8, filmstrip_size: tuple[int, int] = (160, 120),
-                   progress: Optional[Any] = None) -> dict[str, Any]:
+                   progress: Optional[Any] = None, warm_start: Optional[Path] = None) -> dict[str, Any]:
     """Train, then measure; returns metrics, history and the deterministic rollout.
 
     Args:
@@ -88,6 +88,7 @@ def run_evaluation(spec: Any, cur: Any, agent_cfg: Any, workdir: Path, seed: int
         workdir: the evaluation's folder (checkpoint and artifacts).
         seed: the evaluation seed.
         executor_cfg: the ``executor`` group, for ``agent.n_workers > 1``.
+        warm_start: Stage 2: a Stage-1 ``ppo.h5`` to start from (``jt_tasks.jumping.stage2``).
     """
     from toolkit import plugins
     from toolkit.rl import ppo
@@ -111,14 +112,24 @@ def run_evaluation(spec: Any, cur: Any, agent_cfg: Any, workdir: Path, seed: int
         rate = float(np.mean([e.get("success", 0.0) for e in eps])) if eps else math.nan
         z_hist.append((float(samples), float(out.get(z_attr, math.nan)), rate))
         extra["z_history"] = np.asarray(z_hist, dtype=np.float64)
+        nov = [float(e["r_novelty"]) for e in eps if "r_novelty" in e]
+        if nov:  # Stage 2: mean r_novelty (000 eq 12) of the iteration's episodes
+            prev = np.asarray(extra.get("novelty_history", np.zeros((0, 2))), dtype=np.float64).reshape(-1, 2)
+            extra["novelty_history"] = np.vstack([prev, [[float(samples), float(np.mean(nov))]]])
         if progress is not None:
             progress(min(samples / max(cfg.total_samples, 1), 1.0), f"{z_attr} {out.get(z_attr)}")
         return out
 
+    path = Path(workdir) / "ppo.h5"
+    if warm_start is not None:  # Stage 2 (000 §7.1.1): start from the Stage-1 policy
+        from jt_tasks.jumping.stage2 import adopt_architecture, write_warm_start
+
+        cfg = adopt_architecture(cfg, Path(warm_start))
+        if not path.exists():
+            write_warm_start(path, Path(warm_start), cfg, EnvFactory(spec), extra)
     executor = None
     if cfg.n_workers > 1 and executor_cfg is not None:
         executor = plugins.load("executor", str(executor_cfg.name))(executor_cfg)
-    path = Path(workdir) / "ppo.h5"
     t0 = time.perf_counter()
     try:
         result = ppo.train(EnvFactory(spec), cfg, executor, path, resume=True,
@@ -156,6 +167,9 @@ def run_evaluation(spec: Any, cur: Any, agent_cfg: Any, workdir: Path, seed: int
                                if math.isfinite(v)],
                z_attr: [(int(s), z) for s, z, _ in z_hist],
                "success_rate": [(int(s), r) for s, _, r in z_hist if math.isfinite(r)]}
+    nov_hist = np.asarray(result.extra.get("novelty_history", np.zeros((0, 2))), dtype=np.float64).reshape(-1, 2)
+    if len(nov_hist):
+        history["novelty"] = [(int(s), float(v)) for s, v in nov_hist]
     succ = [r for _, _, r in z_hist if math.isfinite(r)]
     sps = hist.get("samples_per_s", [])
     return {"result": result, "rollout": ro, "history": history, "wall_s": wall, "succ": succ,

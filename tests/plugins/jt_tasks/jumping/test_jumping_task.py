@@ -51,11 +51,4 @@ def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
     assert ev2.metrics.get("strategy_angle", math.nan) == pytest.approx(ev.metrics.get("strategy_angle", math.nan), nan_ok=True)
 
 
-def test_stage2_says_it_is_not_implemented(tmp_path):
-    from toolkit import plugins
-    from toolkit.errors import JtError
-    from toolkit.interfaces.task import EvalContext
-
-    task = plugins.load("task", "highjump")(_cfg("task.stage=2"))
-    with pytest.raises(JtError, match="not implemented"):
-        task.evaluate({}, EvalContext(index=0, seed=0, workdir=tmp_path))
+# Stage 2 (task.stage=2): tests/plugins/jt_tasks/jumping/test_stage2.py
