@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 
 import numpy as np
@@ -88,6 +90,8 @@ def test_count_distinct_leader_clustering() -> None:
 def test_config_from_the_composed_run_config() -> None:
     node = OmegaConf.load(Path(__file__).parents[3] / "conf" / "task" / "strategy_landscape.yaml")
     task = StrategyLandscapeTask(OmegaConf.create({"task": node}))
-    assert task.params == StrategyLandscapeTask.Config()  # the YAML holds the defaults
+    # the YAML holds the class defaults, except the landscape it selects (docs/searchers.md)
+    assert node.landscape_seed == 1
+    assert task.params == dataclasses.replace(StrategyLandscapeTask.Config(), landscape_seed=1)
     with pytest.raises(TypeError):
         StrategyLandscapeTask({"task": {"no_such_key": 1}})
