@@ -103,8 +103,11 @@ def _load(name: str, client: Any, urdf: str, pos: Any, orn: Any, fixed_base: boo
     cid = _client_id(client)
     kw = {"physicsClientId": cid}
     pb.setAdditionalSearchPath(pybullet_data.getDataPath(), **kw)
-    body = pb.loadURDF(urdf, list(pos), list(orn), useFixedBase=fixed_base, flags=flags,
-                       globalScaling=scaling, **kw)
+    from toolkit.quiet import native_stderr_silenced
+
+    with native_stderr_silenced():  # the DeepMimic URDF warns once per spherical joint
+        body = pb.loadURDF(urdf, list(pos), list(orn), useFixedBase=fixed_base, flags=flags,
+                           globalScaling=scaling, **kw)
     pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, **kw)
     joints, dofs, kp, kd, lim = [], [], [], [], []
     base_dofs = 0 if fixed_base else 6

@@ -102,10 +102,13 @@ def bullet_character(skeleton: Skeleton, client: int | None = None) -> Iterator[
     cid = pb.connect(pb.DIRECT) if own else client
     try:
         pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=cid)
-        body = pb.loadURDF(
-            skeleton.urdf, globalScaling=skeleton.scale, useFixedBase=False,
-            flags=pb.URDF_MAINTAIN_LINK_ORDER, physicsClientId=cid,
-        )  # fmt: skip
+        from toolkit.quiet import native_stderr_silenced
+
+        with native_stderr_silenced():  # the DeepMimic URDF warns once per spherical joint
+            body = pb.loadURDF(
+                skeleton.urdf, globalScaling=skeleton.scale, useFixedBase=False,
+                flags=pb.URDF_MAINTAIN_LINK_ORDER, physicsClientId=cid,
+            )  # fmt: skip
         try:
             yield cid, body
         finally:

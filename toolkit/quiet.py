@@ -1,0 +1,38 @@
+"""Silence C-level output around noisy native calls (PyBullet's URDF importer warnings)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+from typing import Iterator
+
+
+@contextlib.contextmanager
+def native_stderr_silenced() -> Iterator[None]:
+    """Redirect file descriptors 1 and 2 to /dev/null for the duration (Python's streams flushed).
+
+    PyBullet prints one ``b3Warning ... no axis element for Joint`` per spherical joint of the
+    DeepMimic URDFs on every load, from C (on stdout), past Python's streams. Set
+    ``JT_VERBOSE_NATIVE=1`` to see them.
+    """
+    if os.environ.get("JT_VERBOSE_NATIVE"):
+        yield
+        return
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        saved = (os.dup(1), os.dup(2))
+    except (OSError, ValueError):  # no real descriptors (captured in-process): nothing to silence
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in (*saved, devnull):
+            os.close(fd)
