@@ -225,3 +225,46 @@ def flatten(cfg: Any) -> dict[str, str]:
 
     walk("", OmegaConf.to_container(cfg, resolve=True))
     return out
+
+
+def config_of(config_cls: type, cfg: Any, what: str = "config") -> Any:
+    """A typed ``Config`` dataclass instance from ``None``, an instance, a dataclass, a dict or a
+    group node — the one way every plugin parses its parameters.
+
+    Values are type-checked and converted through OmegaConf's structured configs (``"0.7"`` is
+    rejected for a float, ``1`` becomes ``1.0``). A ``name`` key is dropped unless ``config_cls``
+    declares it.
+
+    Args:
+        config_cls: the plugin's ``Config`` dataclass.
+        cfg: its parameters.
+        what: how to name the plugin in an error (``reward term safety``).
+
+    Raises:
+        JtError: an unknown key (the message lists the valid ones) or a value of the wrong type.
+    """
+    if cfg is None:
+        return config_cls()
+    if isinstance(cfg, config_cls):
+        return cfg
+    from omegaconf import OmegaConf
+
+    if dataclasses.is_dataclass(cfg):
+        params = dataclasses.asdict(cfg)
+    elif isinstance(cfg, dict):
+        params = dict(cfg)
+    else:
+        params = OmegaConf.to_container(cfg, resolve=True)
+    known = {f.name for f in dataclasses.fields(config_cls)}
+    if "name" not in known:
+        params.pop("name", None)
+    unknown = sorted(set(params) - known)
+    if unknown:
+        valid = ", ".join(sorted(known - {"name"}))
+        raise JtError(f"{what}: unknown key(s) {', '.join(unknown)} (valid keys: {valid})")
+    try:
+        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(config_cls), params))
+    except Exception as e:  # noqa: BLE001 - OmegaConf raises several validation types
+        msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        key = getattr(e, "full_key", None)
+        raise JtError(f"{what}: {key + ': ' if key else ''}{msg}") from e

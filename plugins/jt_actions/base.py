@@ -11,32 +11,13 @@ Nothing heavy is imported at module level (``jt plugins`` imports plugin modules
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any, Mapping
 
 import numpy as np
 
 from toolkit.errors import JtError
 from toolkit.interfaces.action import ActionSpace
-from toolkit.interfaces.plugin import Plugin
-
-
-def config_of(config_cls: type, cfg: Any) -> Any:
-    """A ``Config`` instance from ``None``, an instance, a dict or an OmegaConf group node."""
-    if cfg is None:
-        return config_cls()
-    if isinstance(cfg, config_cls):
-        return cfg
-    params = dataclasses.asdict(cfg) if dataclasses.is_dataclass(cfg) else Plugin.params_of(cfg)
-    name = cfg.get("name") if hasattr(cfg, "get") else getattr(cfg, "name", None)
-    known = {f.name for f in dataclasses.fields(config_cls)}
-    unknown = sorted(set(params) - known)
-    if unknown:
-        valid = ", ".join(sorted(known - {"name"}))
-        raise JtError(f"action: unknown key(s) {', '.join(unknown)} (valid keys: {valid})")
-    if name is not None and "name" in known:
-        params["name"] = str(name)
-    return config_cls(**params)
+from toolkit.config import config_of
 
 
 def skeleton_of(character: Any) -> Any:

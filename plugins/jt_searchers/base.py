@@ -2,49 +2,13 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections import deque
 from typing import Any, Sequence
 
 import numpy as np
 
 from toolkit.interfaces.searcher import SearchProblem, Searcher
-
-
-def build_config(config_cls: type, cfg: Any) -> Any:
-    """The plugin's ``Config`` dataclass from a config group.
-
-    Args:
-        config_cls: the searcher's ``Config`` dataclass.
-        cfg: an OmegaConf node, a dict, an instance of ``config_cls``, or ``None`` (all defaults).
-            The bookkeeping key ``name`` is dropped.
-
-    Returns:
-        An instance of ``config_cls``.
-
-    Raises:
-        TypeError: on a key that is not a field of ``config_cls``.
-    """
-    if cfg is None:
-        return config_cls()
-    if isinstance(cfg, config_cls):
-        return cfg
-    if dataclasses.is_dataclass(cfg):
-        params = dataclasses.asdict(cfg)
-    elif isinstance(cfg, dict):
-        params = dict(cfg)
-    else:
-        from omegaconf import OmegaConf
-
-        params = OmegaConf.to_container(cfg, resolve=True)
-    params.pop("name", None)
-    fields = {f.name for f in dataclasses.fields(config_cls)}
-    unknown = sorted(set(params) - fields)
-    if unknown:
-        raise TypeError(
-            f"{config_cls.__qualname__}: unknown key(s) {unknown}; valid keys are {sorted(fields)}"
-        )
-    return config_cls(**params)
+from toolkit.config import config_of
 
 
 def seed_int(*entropy: int) -> int:
@@ -119,7 +83,7 @@ class BudgetedSearcher(Searcher):
     """
 
     def __init__(self, problem: SearchProblem, cfg: Any, seed: int) -> None:
-        super().__init__(problem, build_config(self.Config, cfg), seed)
+        super().__init__(problem, config_of(self.Config, cfg, f"search={type(self).name or type(self).__name__}"), seed)
         self.box = UnitBox(problem)
         self.n_asked = 0
         self.n_told = 0

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 from omegaconf import OmegaConf
 
-from jt_searchers.base import build_config
+from toolkit.config import config_of as build_config
+from toolkit.errors import JtError
 from jt_searchers.bds import BDSSearcher
 from jt_searchers.bsoo import BSOOSearcher
 from jt_searchers.random_search import RandomSearcher
@@ -36,7 +37,7 @@ def test_yaml_holds_every_config_field_with_its_default(name: str) -> None:
 
 
 def test_unknown_key_is_one_clear_error() -> None:
-    with pytest.raises(TypeError, match="unknown key"):
+    with pytest.raises(JtError, match="unknown key"):
         build_config(BDSSearcher.Config, {"name": "bds", "n_explore": 3})
 
 
