@@ -227,7 +227,7 @@ class BulletSimulator(Simulator):
 
     def render(self, width: int = 320, height: int = 240) -> np.ndarray:
         """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, the camera on the root."""
-        from jt_bullet.render import Camera, render_frame
+        from toolkit.render import Camera, render_frame
 
         d, yaw, pitch = DEFAULT_CAMERA.get(self.char_cfg.name, (3.0, 0.0, -10.0))
         c = self.char_cfg

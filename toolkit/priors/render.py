@@ -1,19 +1,18 @@
 """Pictures of decoded poses: pose the character in a PyBullet DIRECT client, render each pose with
 TinyRenderer (no display), tile the frames into one PNG filmstrip.
 
-These few lines repeat what ``jt_bullet.render`` does for simulations: a task plugin may not import
-another plugin, and the pose prior task only needs still poses, so the prior keeps its own copy.
+Still poses are set here directly (no simulation needed); tiling uses ``toolkit.render``, which the
+simulator shares.
 The camera looks at the root from the character's right side (+z in the DeepMimic y-up world).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Sequence
-
 import numpy as np
 
 from toolkit.motion.skeletons import Skeleton
+from toolkit.render import filmstrip
 
 
 def render_poses(
@@ -62,20 +61,6 @@ def render_poses(
                                                  physicsClientId=cid)  # fmt: skip
             frames.append(np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy())
     return frames
-
-
-def filmstrip(frames: Sequence[np.ndarray], columns: int = 0, gap: int = 2) -> np.ndarray:
-    """Frames side by side in rows of ``columns`` (0 = one row), white gaps between them."""
-    if not frames:
-        raise ValueError("no frames to put in a filmstrip")
-    h, w, _ = frames[0].shape
-    cols = columns or len(frames)
-    rows = (len(frames) + cols - 1) // cols
-    strip = np.full((rows * h + (rows - 1) * gap, cols * w + (cols - 1) * gap, 3), 255, np.uint8)
-    for i, f in enumerate(frames):
-        r, c = divmod(i, cols)
-        strip[r * (h + gap) : r * (h + gap) + h, c * (w + gap) : c * (w + gap) + w] = f
-    return strip
 
 
 def save_filmstrip(skeleton: Skeleton, dofs: np.ndarray, path: str | Path, columns: int = 0) -> Path:

@@ -84,7 +84,7 @@ def plot_errors(path: Path, runs: Sequence[Any], title: str) -> Path:
 
 def save_frames(workdir: Path, frames: Sequence[np.ndarray], n_strip: int, fps: float) -> list[str]:
     """``filmstrip.png`` (``n_strip`` evenly spaced frames) and ``tracking.gif``; file names."""
-    from jt_bullet.render import filmstrip, pick, save_animation, save_png
+    from toolkit.render import filmstrip, pick, save_animation, save_png
 
     if not frames:
         return []

@@ -93,11 +93,11 @@ class SPDTrackingTask(Task):
                                               "err_mean_dt600", "n_diverged")
 
     def __init__(self, cfg: Any) -> None:
-        from jt_bullet.config import typed
+        from toolkit.config import config_of
 
         super().__init__(cfg)
         whole = _plain(cfg)
-        self.params: SPDTrackingConfig = typed(SPDTrackingConfig, whole.get("task"), "task")
+        self.params: SPDTrackingConfig = config_of(SPDTrackingConfig, whole.get("task"), "task")
         self.whole = whole
 
     # ------------------------------------------------------------------ config of the runs
@@ -120,13 +120,12 @@ class SPDTrackingTask(Task):
         """The reference motion and model facts (``dof``, ``depth``, ``n_q``, end-effector)."""
         import pybullet as pb
 
-        from jt_bullet.simulator import BulletSimulator
         from jt_tasks.spd_tracking.motions import make_reference
-        from jt_tasks.spd_tracking.tracking import end_effector
+        from jt_tasks.spd_tracking.tracking import end_effector, simulator_class
 
         c = pb.connect(pb.DIRECT)
         try:
-            ch = BulletSimulator.load_character(run_cfg["character"], c)
+            ch = simulator_class(run_cfg).load_character(run_cfg["character"], c)
             ref = make_reference(ch, self.params.motion, self.params.wave)
             model = ch.model()
             facts = {"character": ch.name, "dof": model.n_v, "depth": model.depth,

@@ -32,10 +32,8 @@ def end_effector(character: Any) -> tuple[str, tuple[float, float, float]]:
     """``(link name, offset)`` of the tracked end-effector of a ``Character``."""
     name = character.name
     if name.startswith("snake"):
-        from jt_bullet.urdfgen import SNAKE_SEGMENT
-
         k = len(character.joint_indices)
-        return f"seg{k}", (0.5 * SNAKE_SEGMENT["length"], 0.0, 0.0)  # tail tip
+        return f"seg{k}", (0.5 * _segment_length(character), 0.0, 0.0)  # tail tip
     return END_EFFECTORS[name]
 
 
@@ -88,20 +86,46 @@ def _rotate(q: Any, v: np.ndarray) -> np.ndarray:
     return quat_rotate(np.array(q), v)
 
 
+def _segment_length(character: Any) -> float:
+    """Length of a snake segment: the distance between its last two joint origins at rest."""
+    import pybullet as pb
+
+    a, b = character.joint_indices[-2:]
+    pa = pb.getLinkState(character.body_id, a, physicsClientId=character.client)[4]
+    pb_ = pb.getLinkState(character.body_id, b, physicsClientId=character.client)[4]
+    return float(np.linalg.norm(np.subtract(pb_, pa)))
+
+
+def find_link(client: int, body: int, name: str) -> int:
+    """PyBullet index of the link (or the joint whose child link) called ``name``."""
+    import pybullet as pb
+
+    infos = [pb.getJointInfo(body, j, physicsClientId=client) for j in range(pb.getNumJoints(body, physicsClientId=client))]
+    for j, info in enumerate(infos):
+        if name in (info[12].decode(), info[1].decode()):
+            return j
+    raise KeyError(f"no link or joint {name!r}; links: {', '.join(i[12].decode() for i in infos)}")
+
+
+def simulator_class(run_cfg: Any) -> Any:
+    """The configured simulator plugin class, through the registry."""
+    from toolkit import plugins
+
+    return plugins.load("sim", str((run_cfg.get("sim") or {}).get("name", "bullet")))
+
+
 def reference_vectors(run_cfg: Any, ref: Any, times: np.ndarray) -> np.ndarray:
     """``(p_ee - p_root)`` of the reference at ``times`` ``(n,)`` → ``(n, 3)``, by PyBullet FK."""
     import pybullet as pb
 
-    from jt_bullet import scene
-    from jt_bullet.simulator import BulletSimulator
     from toolkit.dynamics.bullet_io import BulletBody
 
     c = pb.connect(pb.DIRECT)
     try:
-        ch = BulletSimulator.load_character(run_cfg["character"], c)
+        ch = simulator_class(run_cfg).load_character(run_cfg["character"], c)
         io = BulletBody(c, ch.body_id, ch.model())
         link_name, off = end_effector(ch)
-        link = scene.find_link(c, ch.body_id, link_name)
+        link = find_link(c, ch.body_id, link_name)
         zero = np.zeros(ch.n_dof)
         out = np.empty((len(times), 3))
         for i, q in enumerate(ref.poses(np.asarray(times, dtype=float))):
@@ -130,9 +154,6 @@ def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_veloc
     """
     import pybullet as pb
 
-    from jt_bullet import scene
-    from jt_bullet.simulator import BulletSimulator
-
     cfg = {**run_cfg, "sim": {**run_cfg.get("sim", {}), "sim_hz": float(rate_hz),
                               "control_hz": float(rate_hz)}}
     n = max(1, int(round(duration * rate_hz)))
@@ -140,10 +161,10 @@ def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_veloc
     ee_ref = reference_vectors(cfg, ref, times)
     targets = ref.poses(times)
     vels = ref.velocities(times) if target_velocity else [None] * n
-    sim = BulletSimulator(cfg)
+    sim = simulator_class(cfg)(cfg)
     try:
         link_name, off = end_effector(sim.character)
-        link = scene.find_link(sim.client, sim.character.body_id, link_name)
+        link = find_link(sim.client, sim.character.body_id, link_name)
         off = np.asarray(off, float)
         q0, v0 = ref.pose(0.0), ref.velocity(0.0)
         sim.reset(q0, v0)

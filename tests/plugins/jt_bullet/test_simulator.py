@@ -163,7 +163,7 @@ def test_same_inputs_give_identical_states():
 
 
 def test_render_shows_the_character():
-    from jt_bullet.render import Camera, render_frame
+    from toolkit.render import Camera, render_frame
 
     s = make("humanoid")
     try:

@@ -1,5 +1,7 @@
 """Headless rendering with PyBullet's TinyRenderer (no display), to PNG filmstrips and GIF/MP4.
 
+In toolkit because simulators, tasks and the priors all render, and plugins cannot share code.
+
 Frames are RGB arrays ``(height, width, 3)`` uint8. The camera follows a target point and looks
 at it from the side in jt's y-up world (DeepMimic convention): the character runs along +x, so the
 default view is from +z.
