@@ -292,9 +292,22 @@ class JumpEnv(gymnasium.Env):
             if len(self.spec_.policy_features) else np.zeros((0, 4)),
         }
 
+    #: looks at the root from the run-up side, a little above: the mat and the bar wall, which
+    #: stand beyond the athlete from there, never hide it (the simulator's default side view does)
+    CAMERA = {"distance": 4.0, "yaw": 180.0, "pitch": -20.0}
+
     def render(self) -> np.ndarray:
-        """RGB frame ``(240, 320, 3)`` uint8 (the simulator's camera on the root)."""
-        return self.sim.render(320, 240)
+        """RGB frame ``(240, 320, 3)`` uint8, the camera on the root."""
+        return self.render_frame(320, 240)
+
+    def render_frame(self, width: int, height: int) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, looking at the root."""
+        import pybullet as pb
+
+        from toolkit.render import Camera, render_frame
+
+        root = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)[0]
+        return render_frame(self.client, root, width, height, Camera(**self.CAMERA))
 
     def close(self) -> None:
         if getattr(self, "sim", None) is not None:

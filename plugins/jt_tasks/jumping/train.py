@@ -50,7 +50,7 @@ def rollout(env: Any, model: Any, frames: int = 0, width: int = 160, height: int
         coms.append(env._com_and_links()[0])
         times.append(env.t)
         if renders:
-            imgs.append(env.sim.render(width, height))
+            imgs.append(env.render_frame(width, height))
         obs, r, te, tr, info = env.step(model.act(obs).astype(np.float32))
         ret += r
         done = te or tr
@@ -59,7 +59,7 @@ def rollout(env: Any, model: Any, frames: int = 0, width: int = 160, height: int
     coms.append(env._com_and_links()[0])
     times.append(env.t)
     if renders:
-        imgs.append(env.sim.render(width, height))
+        imgs.append(env.render_frame(width, height))
         idx = np.unique(np.linspace(0, len(imgs) - 1, frames).round().astype(int))
         imgs = [imgs[i] for i in idx]
     return {"return": ret, "info": info, "root": np.array(roots), "com": np.array(coms),
