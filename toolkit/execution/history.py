@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -118,7 +118,3 @@ class History:
             hist.add(Record(int(d["index"][i]), int(d["batch"][i]), x, ev, str(d["run_id"][i])))
         return hist
 
-
-def last_point(hist: History) -> Optional[np.ndarray]:
-    """The most recent point evaluated, if any."""
-    return hist.records[-1].x if hist.records else None
