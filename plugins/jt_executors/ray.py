@@ -50,8 +50,9 @@ class RayExecutor(Executor):
         """Cluster address (``ray start --head`` prints it); ``auto`` finds a running one."""
         cpus_per_task: float = 1.0
         """CPUs reserved per evaluation or actor."""
-        max_in_flight: int = 0
-        """Evaluations submitted at once; 0 means all of a batch."""
+        workers: int = 0
+        """Evaluations (or actors) running at once; 0 means as many as the cluster has CPUs for.
+        Same key as ``executor=local``, so presets such as ``experiment=smoke`` apply to both."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
@@ -63,19 +64,25 @@ class RayExecutor(Executor):
         if not ray.is_initialized():
             ray.init(address=getattr(cfg, "address", "auto"), ignore_reinit_error=True)
         self._cpus = float(getattr(cfg, "cpus_per_task", 1.0))
+        self._workers = int(getattr(cfg, "workers", 0) or 0)
 
     @property
     def n_workers(self) -> int:
+        if self._workers > 0:
+            return self._workers
         return max(1, int(self._ray.cluster_resources().get("CPU", 1) // self._cpus))
 
     def imap(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[tuple[int, Any]]:
         remote = self._ray.remote(num_cpus=self._cpus)(fn)
-        refs = {remote.remote(x): i for i, x in enumerate(items)}
-        pending = list(refs)
-        while pending:
-            done, pending = self._ray.wait(pending, num_returns=1)
+        todo = list(enumerate(items))[::-1]
+        refs: dict[Any, int] = {}
+        while todo or refs:
+            while todo and len(refs) < self.n_workers:  # keep at most n_workers in flight
+                i, x = todo.pop()
+                refs[remote.remote(x)] = i
+            done, _ = self._ray.wait(list(refs), num_returns=1)
             for r in done:
-                yield refs[r], self._ray.get(r)
+                yield refs.pop(r), self._ray.get(r)
 
     def actors(self, factory: Callable[..., Any], args: Sequence[tuple]) -> ActorGroup:
         return _RayActors(self._ray, factory, args, self._cpus)
