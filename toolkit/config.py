@@ -268,3 +268,15 @@ def config_of(config_cls: type, cfg: Any, what: str = "config") -> Any:
         msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         key = getattr(e, "full_key", None)
         raise JtError(f"{what}: {key + ': ' if key else ''}{msg}") from e
+
+
+def task_params(config_cls: type, cfg: Any) -> Any:
+    """A task's typed ``Config`` from the whole run config (its ``task`` group), the group itself,
+    or ``None`` (all defaults). Same checks and errors as ``config_of``."""
+    group = cfg
+    if cfg is not None:
+        try:
+            group = cfg["task"] if "task" in cfg else cfg
+        except TypeError:
+            group = getattr(cfg, "task", cfg)
+    return config_of(config_cls, group, "task")

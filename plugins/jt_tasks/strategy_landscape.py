@@ -22,21 +22,9 @@ from typing import Any, ClassVar, Sequence
 
 import numpy as np
 
-from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
-
-
-def task_config(config_cls: type, cfg: Any) -> Any:
-    """The task's ``Config`` from the whole run config (its ``task`` group) or the group itself."""
-    if cfg is None:
-        return config_cls()
-    group = cfg
-    try:
-        group = cfg["task"] if "task" in cfg else cfg
-    except TypeError:
-        group = getattr(cfg, "task", cfg)
-    return config_cls(**Plugin.params_of(group))
+from toolkit.config import task_params
 
 
 class StrategyLandscapeTask(Task):
@@ -63,7 +51,7 @@ class StrategyLandscapeTask(Task):
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        self.params = task_config(self.Config, cfg)
+        self.params = task_params(self.Config, cfg)
         self._build()
 
     # ---- the landscape ----------------------------------------------------------------------------

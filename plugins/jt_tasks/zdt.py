@@ -18,9 +18,9 @@ from typing import Any, ClassVar, Sequence
 
 import numpy as np
 
-from jt_tasks.strategy_landscape import task_config
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
+from toolkit.config import task_params
 
 
 def zdt1(x: np.ndarray) -> np.ndarray:
@@ -66,7 +66,7 @@ class ZDT1Task(Task):
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        self.params = task_config(self.Config, cfg)
+        self.params = task_params(self.Config, cfg)
         if self.params.n_var < 2:
             raise ValueError("zdt1 needs n_var >= 2")
 

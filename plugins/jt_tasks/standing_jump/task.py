@@ -19,18 +19,7 @@ from typing import Any, ClassVar, Sequence
 from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.searcher import SearchProblem
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
-
-
-def _config(config_cls: type, cfg: Any) -> Any:
-    """The task's ``Config`` from the whole run config (its ``task`` group), a group, or None."""
-    if cfg is None:
-        return config_cls()
-    group = cfg
-    try:
-        group = cfg["task"] if "task" in cfg else cfg
-    except TypeError:
-        group = getattr(cfg, "task", cfg)
-    return config_cls(**Plugin.params_of(group))
+from toolkit.config import task_params
 
 
 def _spd_group(cfg: Any) -> dict:
@@ -78,7 +67,7 @@ class StandingJumpTask(Task):
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        self.params = _config(self.Config, cfg)
+        self.params = task_params(self.Config, cfg)
         self.spd = _spd_group(cfg)  # SPD backend (spd=maba|df|sf|pcg), maba without an spd group
 
     # ---- the search problem -------------------------------------------------------------------

@@ -11,6 +11,7 @@ import pytest
 from omegaconf import OmegaConf
 
 from jt_tasks.strategy_landscape import StrategyLandscapeTask, count_distinct
+from toolkit.errors import JtError
 from toolkit.interfaces.task import EvalContext
 
 
@@ -93,5 +94,5 @@ def test_config_from_the_composed_run_config() -> None:
     # the YAML holds the class defaults, except the landscape it selects (docs/searchers.md)
     assert node.landscape_seed == 1
     assert task.params == dataclasses.replace(StrategyLandscapeTask.Config(), landscape_seed=1)
-    with pytest.raises(TypeError):
+    with pytest.raises(JtError, match="unknown key"):
         StrategyLandscapeTask({"task": {"no_such_key": 1}})
