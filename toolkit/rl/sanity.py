@@ -129,13 +129,16 @@ def bench_workers(
         ``{n_workers: {"samples_per_s": total, "collect_samples_per_s": collection only}}``,
         measured over the iterations after the first (which includes worker start-up).
     """
-    from jt_executors.local import LocalExecutor
+    from omegaconf import OmegaConf
 
+    from toolkit import plugins
+
+    local = plugins.load("executor", "local")  # through the registry: toolkit never imports a plugin
     out: dict[int, dict[str, float]] = {}
     for n in workers:
         cfg = sanity_config(iterations * 1600, 0, n)
         stats: list[dict[str, float]] = []
-        with LocalExecutor(LocalExecutor.Config(workers=n)) as ex:
+        with local(OmegaConf.create({"name": "local", "workers": n, "start_method": "spawn"})) as ex:
             train(GymEnvFn(env_id), cfg, executor=ex,
                   on_iteration=lambda i, s, st: stats.append(st))
         steady = stats[1:]
