@@ -233,7 +233,9 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
     evs = history.evaluations()
     out_dir = workdir / "summary"
     out_dir.mkdir(exist_ok=True)
-    metrics = {k: float(v) for k, v in (task.summarize(evs, out_dir) or {}).items()}
+    summary = task.summarize(evs, out_dir) or {}
+    curves = {k: v for k, v in summary.items() if not isinstance(v, (int, float))}
+    metrics = {k: float(v) for k, v in summary.items() if k not in curves}
     metrics["n_evaluations"] = float(len(evs))
     metrics["n_failed"] = float(sum(e.failed for e in evs))
     if nested and evs:
@@ -243,6 +245,9 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
                 metrics[f"best_{key}"] = float(max(vals))
     with store.metrics(run_id) as buf:
         buf.add_many(metrics)
+        for key, points in curves.items():  # run-level curves: [(step, value), ...]
+            for step, value in points:
+                buf.add(key, float(value), int(step))
     if not nested:  # the evaluations were logged on this run: report their metrics as the run's
         for e in evs:
             metrics = {**{k: float(v) for k, v in e.metrics.items()}, **metrics}

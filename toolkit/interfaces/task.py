@@ -88,6 +88,10 @@ class Task(Plugin, abc.ABC):
     def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
         """Run one evaluation at ``point`` (names of ``problem().space``)."""
 
-    def summarize(self, evaluations: Sequence[Evaluation], workdir: Path) -> dict[str, float]:
-        """Run-level metrics over all evaluations; may write files (tables, plots) to ``workdir``."""
+    def summarize(self, evaluations: Sequence[Evaluation], workdir: Path) -> dict[str, Any]:
+        """Run-level metrics over all evaluations; may write files (tables, plots) to ``workdir``.
+
+        A value is a float (one metric) or a curve ``[(step, value), ...]`` logged as that metric's
+        history (e.g. the hypervolume after each simulation).
+        """
         return {}

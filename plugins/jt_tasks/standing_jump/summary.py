@@ -45,6 +45,24 @@ def sample_table(evs: Sequence[Evaluation], reference: Sequence[float]) -> dict[
     return cols
 
 
+def hypervolume_curve(F: np.ndarray, reference: Sequence[float], ok: np.ndarray) -> np.ndarray:
+    """Hypervolume of the successful samples among the first ``k`` evaluations, ``k = 1..n`` → ``(n,)``.
+
+    ``F`` ``(n, 2)`` objectives in evaluation order, ``ok`` ``(n,)`` success flags. Only the
+    current front matters for the next value, so each step adds one point to a small set.
+    """
+    from jt_tasks.standing_jump.objectives import hypervolume, non_dominated
+
+    out = np.zeros(len(F))
+    front = np.zeros((0, F.shape[1] if F.ndim == 2 else 2))
+    for i in range(len(F)):
+        if ok[i] and np.all(np.isfinite(F[i])):
+            front = np.vstack([front, F[i][None]])
+            front = front[non_dominated(front, valid=np.ones(len(front), bool))]
+        out[i] = hypervolume(front, reference, valid=np.ones(len(front), bool)) if len(front) else 0.0
+    return out
+
+
 def summarize(task: Any, evaluations: Sequence[Evaluation], workdir: Path) -> dict[str, float]:
     """Write ``front.h5``, ``front.png`` and filmstrips to ``workdir``; return run metrics."""
     from jt_tasks.standing_jump import params as P
@@ -61,12 +79,14 @@ def summarize(task: Any, evaluations: Sequence[Evaluation], workdir: Path) -> di
     front_idx = np.flatnonzero(t["non_dominated"])
     front_idx = front_idx[np.argsort(t["height"][front_idx])]
     table = {k: t[k] for k in COLUMNS}
+    curve = hypervolume_curve(t["objectives"], ref, ok)
     h5.write(workdir / "front.h5", {
         "samples": {**table, "effort": t["effort"], "external_energy": t["external_energy"],
                     "landing_x": t["landing_x"], "natural": t["natural"], "failed": t["failed"],
                     "non_dominated": t["non_dominated"], "objectives": t["objectives"], "x": X},
         "front": {**{k: v[front_idx] for k, v in table.items()}, "index": front_idx,
                   "effort": t["effort"][front_idx], "natural": t["natural"][front_idx], "x": X[front_idx]},
+        "hypervolume_curve": curve,
         "param_names": np.array(names),
         "objective_names": np.array(["neg_height", "effort"]),
         "reference_point": np.asarray(ref, float),
@@ -84,6 +104,7 @@ def summarize(task: Any, evaluations: Sequence[Evaluation], workdir: Path) -> di
         "max_height": float(t["height"][ok].max()) if np.any(ok) else math.nan,
         "min_effort": float(t["effort"][ok].min()) if np.any(ok) else math.nan,
     }
+    out["hypervolume_curve"] = [(i + 1, float(v)) for i, v in enumerate(curve)]  # vs simulations (004 §5)
     if evs:
         front_plot(t["height"], t["effort"], t["non_dominated"], t["natural"], t["failed"], workdir / "front.png",
                    out["max_natural_height"])

@@ -8,6 +8,7 @@ import sys
 import time
 
 import numpy as np
+import pytest
 
 from tests.conftest import jt_env
 from toolkit.config import compose
@@ -36,6 +37,10 @@ def test_search_runs_evaluations_as_nested_runs(example_plugin, store_dir):
     hist = h5.read(store.artifact_dir(res.run_id) / "search_history.h5")
     assert hist["x"].shape == (4, 2) and list(hist["batch"]) == [0, 0, 1, 1]
     assert outer.data.metrics["n_evaluations"] == 4
+    values = [c.data.metrics["value"] for c in sorted(children, key=lambda c: int(c.data.tags["jt.eval_index"]))]
+    best = store.client.get_metric_history(res.run_id, "best_so_far")  # a summarize() curve
+    assert [m.step for m in sorted(best, key=lambda m: m.step)] == [1, 2, 3, 4]
+    assert [m.value for m in sorted(best, key=lambda m: m.step)] == pytest.approx(np.minimum.accumulate(values))
 
 
 def test_same_seed_same_result(example_plugin, store_dir):

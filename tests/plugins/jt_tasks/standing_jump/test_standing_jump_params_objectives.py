@@ -96,3 +96,16 @@ def test_hypervolume_of_a_staircase():
     ys = np.linspace(10, 15, 501)[:-1] + 0.005
     cells = sum(any(np.all(f <= [x, y]) for f in F) for x, y in itertools.product(xs[::10], ys[::10]))
     assert cells * (0.1 * 0.1) == pytest.approx(expected, rel=0.05)
+
+
+def test_hypervolume_curve_is_the_hypervolume_of_every_prefix():
+    from jt_tasks.standing_jump.summary import hypervolume_curve
+
+    rng = np.random.default_rng(0)
+    F = rng.uniform(0.0, 1.0, size=(40, 2))
+    ok = rng.uniform(size=40) > 0.2
+    ref = (1.0, 1.0)
+    curve = hypervolume_curve(F, ref, ok)
+    brute = [O.hypervolume(F[: k + 1], ref, valid=ok[: k + 1]) for k in range(len(F))]
+    np.testing.assert_allclose(curve, brute, rtol=1e-12)
+    assert np.all(np.diff(curve) >= 0) and curve[-1] > curve[0]

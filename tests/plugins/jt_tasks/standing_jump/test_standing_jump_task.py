@@ -121,6 +121,9 @@ def test_summarize_writes_the_front_table_and_pictures(runs, task, tmp_path):
     assert out["n_front"] == float(np.sum(s["non_dominated"]))
     assert out["max_natural_height"] == pytest.approx(runs["seed"].metrics["height"])
     assert out["hypervolume"] > 0.0
+    steps, curve = zip(*out["hypervolume_curve"])  # hypervolume against simulations (004 §5)
+    assert steps == (1, 2, 3) and curve[-1] == pytest.approx(out["hypervolume"])
+    assert list(data["hypervolume_curve"]) == pytest.approx(list(curve))
     assert (tmp_path / "front.png").stat().st_size > 1000
     assert (tmp_path / "filmstrip_lowest_natural.png").stat().st_size > 1000
     assert (tmp_path / "filmstrip_highest_natural.png").exists()
