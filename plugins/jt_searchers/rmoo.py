@@ -30,6 +30,9 @@ from jt_searchers.mo_cmaes import (
 from jt_searchers.pareto import selection_order
 
 
+SUCCESS_RULES = ("parent", "selected")  #: the two success definitions of ``Config.success``
+
+
 class RMOOSearcher(BudgetedSearcher):
     """Re-sampled MO-CMA-ES: mu (1+1)-CMA-ES parents, hypervolume selection, failure resampling."""
 
@@ -44,6 +47,9 @@ class RMOOSearcher(BudgetedSearcher):
         tol: float = 1e-9  # "change of fitness for all samples < epsilon" (004 Alg. 1; epsilon not given)
         patience: int = 10  # generations the change must stay below tol (ours: one generation without a
         # selected child is common for an elitist ES, so a single one does not mean convergence)
+        success: str = "parent"  # "parent": a child succeeds when it ranks above its parent (Igel et al.
+        # 2007, which 004 §4.2.1 follows); "selected": when it is selected into the next parents
+        # (Voss, Hansen, Igel 2010, "Improved step size adaptation for the MO-CMA-ES")
 
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
@@ -51,6 +57,8 @@ class RMOOSearcher(BudgetedSearcher):
             raise ValueError("rmoo needs a task whose problem() declares n_objectives >= 1")
         if self.cfg.mu < 1:
             raise ValueError("rmoo needs mu >= 1")
+        if self.cfg.success not in SUCCESS_RULES:
+            raise ValueError(f"rmoo: success={self.cfg.success!r}; choose one of: {', '.join(SUCCESS_RULES)}")
         self.M = problem.n_objectives
         self.par = StrategyParameters.for_dim(self.box.dim)
         self.x0 = np.clip(self.box.to_unit(problem.space.defaults()), 0.0, 1.0)
@@ -134,7 +142,10 @@ class RMOOSearcher(BudgetedSearcher):
         self._failed_at_selection.append(sum(c.failed for c in self.children))
         for k in range(mu):
             parent, child = self.parents[k], self.children[k]
-            success = float(position[mu + k] < position[k])
+            if self.cfg.success == "selected":
+                success = float(position[mu + k] < mu)
+            else:
+                success = float(position[mu + k] < position[k])
             step = step_of(parent, child)
             update_step_size(parent, success, self.par)
             update_step_size(child, success, self.par)
