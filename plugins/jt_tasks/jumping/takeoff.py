@@ -113,8 +113,12 @@ def reference_state(clip: Any, t: float, h: float = 1.0 / 120.0) -> tuple[np.nda
 
 
 def impose(root_rot: np.ndarray, v: np.ndarray, w: np.ndarray, features: dict[str, float],
-           omega_y: Optional[float]) -> tuple[np.ndarray, np.ndarray]:
-    """World root velocities ``(v (3,), w (3,))`` with features imposed in the facing frame."""
+           omega_y: Optional[float], v_y: Optional[float] = None) -> tuple[np.ndarray, np.ndarray]:
+    """World root velocities ``(v (3,), w (3,))`` with features imposed in the facing frame.
+
+    ``v_y`` (not None) replaces the vertical root speed: the "jumping intention" (see
+    ``takeoff_state``).
+    """
     hq = heading_quat(root_rot)
     inv = rot.quat_conjugate(hq)
     v_f = rot.quat_rotate(inv, v)
@@ -126,11 +130,14 @@ def impose(root_rot: np.ndarray, v: np.ndarray, w: np.ndarray, features: dict[st
         w_f[1] = omega_y
     if "v_z" in features:
         v_f[2] = features["v_z"]
+    if v_y is not None:
+        v_f[1] = float(v_y)
     return rot.quat_rotate(hq, v_f), rot.quat_rotate(hq, w_f)
 
 
 def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str = "right",
-                  omega_y: Optional[float] = 3.0, contact_tol: float = 0.06) -> TakeoffState:
+                  omega_y: Optional[float] = 3.0, contact_tol: float = 0.06,
+                  v_y: Optional[float] = None) -> TakeoffState:
     """The take-off state of ``clip_name`` with ``features`` imposed, heading along world +x.
 
     Args:
@@ -140,6 +147,11 @@ def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str 
         omega_y: fixed root angular velocity about up in the facing frame (high jump: 3 rad/s,
             ``000`` §6.1.1); None keeps the clip's.
         contact_tol: a foot within this height (m) of its lowest is on the ground.
+        v_y: vertical root speed (m/s) imposed at take-off; None keeps the clip's (~0 at
+            mid-support of a steady run). ``000`` §8: the authors' reference runs end in "a low
+            in-place jump after the last running step" and "this jumping intention" is embedded
+            in their take-off states; DeepMimic's steady run has none, so jt imposes it
+            (``liftoff_vertical_speed`` of the jump clip gives the default, docs/highjump.md).
 
     Returns:
         The state; its root is above the origin and the foot clearance is applied by the env.
@@ -151,7 +163,7 @@ def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str 
     clip = load_clip(path)
     t, _ = support_phase_time(clip, foot, contact_tol)
     p, r, j, v, w, jv = reference_state(clip, t)
-    v, w = impose(r, v, w, features, omega_y)
+    v, w = impose(r, v, w, features, omega_y, v_y)
     # turn the whole state about +y so the heading is +x, and put the root above the origin
     inv = rot.quat_conjugate(heading_quat(r))
     r = rot.quat_normalize(rot.quat_multiply(inv, r))
@@ -159,6 +171,24 @@ def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str 
     q = np.concatenate([[0.0, p[1], 0.0], r, j])
     qd = np.concatenate([v, w, jv])
     return TakeoffState(q=q, qd=qd, time=t, foot=foot, features=dict(features))
+
+
+def liftoff_vertical_speed(clip_name: str = "jump") -> float:
+    """Largest vertical root speed (m/s) of a DeepMimic humanoid clip, by central differences.
+
+    For ``humanoid3d_jump.txt`` (a standing jump) this is the root's speed at lift-off, 2.03 m/s:
+    the source of the jumping tasks' default ``v_y``.
+    """
+    from toolkit.motion import load_clip
+    from toolkit.motion.skeletons import motions_dir
+
+    path = clip_name if os.path.sep in clip_name else os.path.join(motions_dir(), f"humanoid3d_{clip_name}.txt")
+    clip = load_clip(path)
+    h = 1.0 / 120.0
+    times = np.linspace(h, clip.duration - h, 4 * len(clip.times))
+    p = clip.sample(np.concatenate([times - h, times + h]))[0]
+    n = len(times)
+    return float(np.max((p[n:, 1] - p[:n, 1]) / (2 * h)))
 
 
 def facing_velocities(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -59,6 +59,8 @@ class JumpConfig:
     clip: str = "run"  # reference run clip (000 §6.1.1)
     foot: str = "right"  # take-off foot (ours: the outer foot of a Fosbury with the bar on the left)
     omega_y: Optional[float] = 3.0  # rad/s, fixed facing-frame omega_y of the high jump (000 §6.1.1)
+    v_y: Optional[float] = 2.06  # m/s vertical root speed at take-off, the "jumping intention" of 000 §8
+    # (ours: humanoid3d_jump.txt's lift-off speed, takeoff.liftoff_vertical_speed); None: the run clip's
     time_limit: float = 2.0  # s (000 §6.1)
     safe_margin: float = 0.2  # m (000 §6.1)
     check_every: int = 1  # substeps between contact checks (1 = every 600 Hz substep)
@@ -157,7 +159,7 @@ class JumpTask(Task):
         init = self.stage2_init()
         pol = init.policy_features if init is not None else (p.policy_features or [])
         return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
-                       omega_y=p.omega_y if self.kind == "highjump" else None,
+                       omega_y=p.omega_y if self.kind == "highjump" else None, v_y=p.v_y,
                        time_limit=p.time_limit, safe_margin=p.safe_margin, check_every=p.check_every,
                        sim=sim, action=action, reward_terms=terms,
                        policy_features=[list(map(float, f)) for f in pol])
