@@ -1,0 +1,260 @@
+"""The run-up environment (``gymnasium.Env``): imitate the reference run, reach the take-off features.
+
+DeepMimic (Peng et al. 2018) as ``000`` §6.1.1 uses it for the run-up controllers:
+
+* reference state initialisation: each episode starts in the reference state at a random clip
+  time ``t0`` (uniform over one cycle, drawn from the env's ``np_random``, rounded to the
+  simulation grid ``1 / sim_hz``; ``reset(options={"time": t0})`` fixes it);
+* the episode ends at the take-off instant: the ``n_strides``-th middle of a support phase of the
+  take-off foot after ``t0`` (at least one control step later; same definition as
+  ``jt_tasks.jumping.takeoff``), so it lasts between ``n_strides - 1`` and ``n_strides`` cycles;
+  the last control step runs only the substeps left to that instant;
+* early termination: any body part other than the feet touching the ground, or a failed
+  simulation (NaN / exploding), ends the episode without the task reward;
+* control at ``control_hz`` (30 Hz), ``round(sim_hz / control_hz)`` substeps at the simulator's
+  rate (600 Hz), the action space plugin (``raw``: the action is the PD targets) giving the
+  internal joints' PD targets.
+
+Reward of a control step (``reward.py``): ``w_I r_I`` and, at the take-off instant only,
+``w_G · goal_steps · r_G`` added (``goal_steps`` = the episode's number of control steps unless
+set: the terminal r_G then weighs as if it had been earned on every step, so that the split of the
+best return between imitation and goal is ``w_I : w_G``). The paper gives no weights; ours.
+
+Observation ``(obs_dim,)`` float32, DeepMimic-like, in the facing frame of the root: root height,
+root orientation (6D), root linear and angular velocity, joint positions (quaternions / angles)
+and velocities, link centres of mass relative to the root, the clip phase (sin, cos) and the
+strides left to the take-off.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Optional
+
+import numpy as np
+import gymnasium
+from gymnasium import spaces
+
+from jt_tasks.jumping.takeoff import FOOT_LINKS, heading_quat
+from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
+from jt_tasks.runup import reward as rw
+from toolkit.motion import rotations as rot
+
+
+@dataclasses.dataclass
+class RunupSpec:
+    """Everything a run-up environment needs, as plain picklable data."""
+
+    kind: str = "highjump"  # highjump (000 eq 13) | obstacle (000 eq 14)
+    target: dict = dataclasses.field(default_factory=dict)  # desired take-off features by name
+    omega_y: Optional[float] = 3.0  # high jump: fixed omega_y target (000 §6.1.1)
+    clip: str = "run"  # reference run (DeepMimic humanoid3d_run.txt)
+    foot: str = "right"  # take-off foot
+    n_strides: int = 2  # take-off-foot mid-supports up to the take-off (ours)
+    contact_tol: float = 0.06  # m: support-phase detection (jumping/takeoff.py)
+    foot_clearance: float = 0.002  # m: take-off foot above the ground at take-off in the reference
+    control_hz: float = 30.0  # Peng et al. 2018: policy queried at 30 Hz
+    check_every: int = 1  # substeps between contact checks
+    w_imitation: float = 0.7  # ours (DeepMimic's task examples use 0.7 / 0.3)
+    w_goal: float = 0.3  # ours
+    goal_steps: Optional[float] = None  # terminal multiplier of w_G r_G; None: the episode's steps
+    sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
+    action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
+
+
+class RunupEnv(gymnasium.Env):
+    """DeepMimic run-up (000 §6.1.1): imitate the run, end at take-off with the target features."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, spec: RunupSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
+        import pybullet as pb
+        from omegaconf import OmegaConf
+
+        from toolkit import plugins
+
+        super().__init__()
+        self.spec_ = spec
+        self.render_mode = render_mode
+        self._pb = pb
+        self.targets = rw.goal_targets(spec.kind, spec.target, spec.omega_y)
+        sim_cfg = OmegaConf.create(dict(spec.sim))
+        sim_cfg.sim = OmegaConf.merge(sim_cfg.get("sim") or {}, {"contacts": False})
+        sim_name = str((sim_cfg.sim.get("name") if "name" in sim_cfg.sim else None) or "bullet")
+        self.sim = plugins.load("sim", sim_name)(sim_cfg)
+        self.client = self.sim.client
+        self.body = self.sim.character.body_id
+        self.ground = int(getattr(self.sim, "ground_id", -1))
+        self.sim_hz = float(self.sim.params.sim_hz)
+        self.sim.n_substeps = 1
+        self.control_hz = float(spec.control_hz)
+        self.substeps = max(1, int(round(self.sim_hz / self.control_hz)))
+        self.n_links = pb.getNumJoints(self.body, physicsClientId=self.client)
+        self.feet = {FOOT_LINKS["right"], FOOT_LINKS["left"]}
+        self.ref = RunReference(spec.clip, spec.foot, spec.contact_tol, spec.foot_clearance, self.sim_hz)
+        self.masses = np.array([pb.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
+                                for i in range(-1, self.n_links)])
+        act_cfg = OmegaConf.create(dict(spec.action))
+        self.action_space_ = plugins.load("action", str(act_cfg.name))(act_cfg, "humanoid")
+        self.skeleton = self.action_space_.skeleton
+        low, high = self.action_space_.bounds()
+        self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
+        if seed is not None:
+            self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
+        self._start(self.ref.t_mid)
+        obs = self._obs()
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
+
+    # ------------------------------------------------------------------ episode bookkeeping
+    def _start(self, t0: float) -> None:
+        """Reference state initialisation at clip time ``t0`` (rounded to the simulation grid)."""
+        self.j0 = int(round(float(t0) * self.sim_hz))
+        self.t0 = self.j0 / self.sim_hz
+        self.t_takeoff = self.ref.takeoff_time(self.t0, self.spec_.n_strides, 1.0 / self.control_hz)
+        self.total_substeps = max(1, int(round((self.t_takeoff - self.t0) * self.sim_hz)))
+        self.n_steps = math.ceil(self.total_substeps / self.substeps)
+        self.substeps_done = 0
+        ref = self.ref.at(self.j0)
+        q, qd = ref.q.copy(), ref.qd.copy()
+        lift = self.spec_.foot_clearance - self.ref.lowest_point(q)
+        if lift > 0:  # the clip's feet dip into the ground at some frames: never start inside it
+            q[1] += lift
+        self.sim.reset(q, qd)
+        self.action_space_.reset(None)
+        self.done = False
+        self.terms_log: list[dict[str, float]] = []
+
+    @property
+    def t(self) -> float:
+        """Time since the episode start (s)."""
+        return self.substeps_done / self.sim_hz
+
+    @property
+    def clip_time(self) -> float:
+        """Reference clip time of the current state (s)."""
+        return (self.j0 + self.substeps_done) / self.sim_hz
+
+    def links_and_com(self) -> tuple[np.ndarray, np.ndarray]:
+        """Simulated link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)``."""
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        pos, _ = pb.getBasePositionAndOrientation(self.body, **kw)
+        states = pb.getLinkStates(self.body, list(range(self.n_links)), **kw)
+        links = np.array([pos] + [s[0] for s in states])
+        return links, self.masses @ links / self.masses.sum()
+
+    def _obs(self) -> np.ndarray:
+        q, qd = self.sim.state()
+        links, _ = self.links_and_com()
+        hq = heading_quat(q[3:7])
+        inv = rot.quat_conjugate(hq)
+        r_local = rot.quat_multiply(inv, q[3:7])
+        rel = facing_frame(q, links[1:])
+        ph = 2.0 * math.pi * self.ref.phase(self.clip_time)
+        left = (self.total_substeps - self.substeps_done) / (self.sim_hz * self.ref.period)
+        parts = [[q[1]], rot.quat_to_6d(r_local), rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6]),
+                 q[7:], qd[6:], rel.reshape(-1), [math.sin(ph), math.cos(ph), left]]
+        return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
+
+    def _fallen(self) -> bool:
+        """A body part other than the feet touches the ground (DeepMimic's early termination)."""
+        pts = self._pb.getContactPoints(bodyA=self.body, bodyB=self.ground, physicsClientId=self.client)
+        return any(int(p[3]) not in self.feet for p in pts)
+
+    def imitation(self) -> dict[str, float]:
+        """The imitation terms (``reward.imitation_terms``) of the current state vs the reference."""
+        q, qd = self.sim.state()
+        ref = self.ref.at(self.j0 + self.substeps_done)
+        links, com = self.links_and_com()
+        ee = [i + 1 for i in END_EFFECTORS]  # base is row 0
+        return rw.imitation_terms(self.skeleton, q, qd, facing_frame(q, links[ee]), com,
+                                  ref.q, ref.qd, facing_frame(ref.q, ref.links[ee]), ref.com)
+
+    # ------------------------------------------------------------------ gymnasium API
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None) -> tuple[np.ndarray, dict]:
+        super().reset(seed=seed)
+        if options and options.get("time") is not None:
+            t0 = float(options["time"])
+        else:
+            t0 = float(self.np_random.uniform(0.0, self.ref.period))
+        self._start(t0)
+        return self._obs(), {"start_time": self.t0, "takeoff_time": self.t_takeoff, "n_steps": self.n_steps}
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:
+        if self.done:
+            raise RuntimeError("step() after the episode ended; call reset()")
+        targets = self.action_space_.targets(np.asarray(action, dtype=np.float64))
+        q, _ = self.sim.state()
+        q_target = np.concatenate([q[:7], self.skeleton.dofs_to_joints(targets)])
+        n = min(self.substeps, self.total_substeps - self.substeps_done)
+        reason = ""
+        for k in range(n):
+            rec = self.sim.step(q_target)
+            self.substeps_done += 1
+            if rec["failed"]:
+                reason = f"simulator: {rec['reason']}"
+                break
+            if ((k + 1) % self.spec_.check_every == 0 or k + 1 == n) and self._fallen():
+                reason = "fell"
+                break
+        if reason.startswith("simulator"):  # NaN / exploded state: nothing to compare
+            terms = {k: 0.0 for k in ("pose", "vel", "ee", "com", "imitation")}
+        else:
+            terms = self.imitation()
+        self.terms_log.append(terms)
+        reward = self.spec_.w_imitation * terms["imitation"]
+        obs = self._obs()
+        took_off = not reason and self.substeps_done >= self.total_substeps
+        if not reason and not took_off:
+            return obs, float(reward), False, False, {}
+        self.done = True
+        info = self._final_info(took_off, reason)
+        if took_off:
+            k_goal = float(self.n_steps if self.spec_.goal_steps is None else self.spec_.goal_steps)
+            reward += self.spec_.w_goal * k_goal * info["r_goal"]
+        obs = np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0)
+        return obs, float(reward), True, False, info
+
+    def _final_info(self, took_off: bool, reason: str) -> dict[str, Any]:
+        q, qd = self.sim.state()
+        finite = bool(np.all(np.isfinite(q)) and np.all(np.isfinite(qd)))
+        achieved = rw.measure(q, qd) if finite else {k: 0.0 for k in rw.MEASURED}
+        r_goal = rw.goal_reward(self.spec_.kind, achieved, self.targets) if took_off else 0.0
+        info: dict[str, Any] = {"r_goal": float(r_goal), "took_off": float(took_off), "fell": float(not took_off),
+                                "reason": reason or "take-off", "episode_time": self.t,
+                                "start_time": self.t0, "steps": float(len(self.terms_log))}
+        for k in ("imitation", "pose", "vel", "ee", "com"):
+            info[f"r_{k}_mean"] = float(np.mean([t[k] for t in self.terms_log]))
+        info.update({f"takeoff_{k}": v for k, v in achieved.items()})
+        info.update({f"target_{k}": v for k, v in self.targets.items()})
+        return info
+
+    def takeoff_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """The simulated ``(q, qd)`` now (world); call it when an episode ended at take-off."""
+        return self.sim.state()
+
+    def render(self) -> np.ndarray:
+        """RGB frame ``(240, 320, 3)`` uint8, the camera on the root."""
+        return self.render_frame(320, 240)
+
+    def render_frame(self, width: int, height: int) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer (the simulator's side view)."""
+        return self.sim.render(width, height)
+
+    def close(self) -> None:
+        if getattr(self, "ref", None) is not None:
+            self.ref.close()
+            self.ref = None
+        if getattr(self, "sim", None) is not None:
+            self.sim.close()
+            self.sim = None
+
+
+class EnvFactory:
+    """Picklable ``env_fn(seed) -> RunupEnv`` for PPO's rollout workers."""
+
+    def __init__(self, spec: RunupSpec) -> None:
+        self.spec = spec
+
+    def __call__(self, seed: int) -> RunupEnv:
+        return RunupEnv(self.spec, seed=seed)
