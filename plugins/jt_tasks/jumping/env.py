@@ -55,6 +55,7 @@ class EnvSpec:
     foot: str = "right"  # take-off foot
     omega_y: Optional[float] = 3.0  # fixed facing-frame omega_y (000 §6.1.1), None: keep / explored
     v_y: Optional[float] = None  # imposed vertical root speed at take-off (jumping intention), None: the clip's
+    takeoff_file: str = ""  # a run-up's takeoff_state.h5 to start from instead of the clip frame (takeoff_source)
     foot_clearance: float = 0.002  # m between the take-off foot and the ground at reset (ours)
     time_limit: float = 2.0  # s after take-off (000 §6.1)
     safe_margin: float = 0.2  # m from the wall for a success (000 §6.1)
@@ -101,7 +102,12 @@ class JumpEnv(gymnasium.Env):
                       for name, params in (spec.reward_terms or {}).items()}
         self.suite = Suite(self.client, spec.suite)
         feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
-        self.takeoff = takeoff_state(feats, spec.clip, spec.foot, spec.omega_y, v_y=spec.v_y)
+        if spec.takeoff_file:
+            from jt_tasks.jumping import takeoff_source
+
+            self.takeoff = takeoff_source.load(spec.takeoff_file, spec.foot, spec.v_y)
+        else:
+            self.takeoff = takeoff_state(feats, spec.clip, spec.foot, spec.omega_y, v_y=spec.v_y)
         self._q0, self._qd0 = self._place(self.takeoff.q, self.takeoff.qd)
         self.control_hz = float(spec.control_hz)
         self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)

@@ -53,6 +53,7 @@ class JumpConfig:
     point: dict = dataclasses.field(default_factory=dict)  # fixed take-off features overriding the searched ones
     ranges: dict = dataclasses.field(default_factory=dict)  # {feature: [low, high]} (see the task YAML)
     takeoff: dict = dataclasses.field(default_factory=dict)  # {feature: default value} (the searched point's defaults)
+    takeoff_from: str = ""  # task=runup run id / folder / takeoff_state.h5 to start from (000 §6.1.1); "": the clip frame
     distance: float = 0.9  # m, take-off point to the bar plane / obstacle (ours)
     obstacle_height: float = 0.5  # m (000 §6.1); 0 for the long jump
     mat_height: float = 0.3  # m, rigid landing block (ours)
@@ -90,6 +91,7 @@ class JumpTask(Task):
         params = Plugin.params_of(group) if group is not None else {}
         self.params = self.Config(**params)
         self._stage2: Any = None
+        self._takeoff_file: Optional[Path] = None
 
     # ------------------------------------------------------------------ Stage 2 (000 §5.2)
     def stage2_init(self) -> Any:
@@ -110,10 +112,28 @@ class JumpTask(Task):
             self._stage2 = resolve(p, str(store) if store is not None else None, str(p.name), self.feature_names)
         return self._stage2
 
+    def takeoff_file(self) -> Optional[Path]:
+        """The run-up's ``takeoff_state.h5`` of ``task.takeoff_from`` (resolved once); None if unset."""
+        ref = str(self.params.takeoff_from or "").strip()
+        if ref and self._takeoff_file is None:
+            from jt_tasks.jumping import takeoff_source
+
+            store = _group(self.cfg, "store") if self.cfg is not None else None
+            self._takeoff_file = takeoff_source.resolve(ref, str(store) if store is not None else None)
+        return self._takeoff_file if ref else None
+
     def _fixed(self) -> dict:
-        """Take-off features not searched: ``task.point``, or in Stage 2 the init's take-off state."""
+        """Take-off features not searched: ``task.point``, a run-up's achieved ones
+        (``task.takeoff_from``), or in Stage 2 the init's take-off state."""
         init = self.stage2_init()
-        return dict(init.features) if init is not None else dict(self.params.point or {})
+        if init is not None:
+            return dict(init.features)
+        fixed = dict(self.params.point or {})
+        if self.takeoff_file() is not None:
+            from jt_tasks.jumping import takeoff_source
+
+            fixed.update(takeoff_source.features(self.takeoff_file(), self.feature_names))
+        return fixed
 
     # ------------------------------------------------------------------ search problem
     def ranges(self) -> dict[str, tuple[float, float]]:
@@ -160,6 +180,7 @@ class JumpTask(Task):
         pol = init.policy_features if init is not None else (p.policy_features or [])
         return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
                        omega_y=p.omega_y if self.kind == "highjump" else None, v_y=p.v_y,
+                       takeoff_file=str(self.takeoff_file() or ""),
                        time_limit=p.time_limit, safe_margin=p.safe_margin, check_every=p.check_every,
                        sim=sim, action=action, reward_terms=terms,
                        policy_features=[list(map(float, f)) for f in pol])

@@ -1,0 +1,81 @@
+"""``task.takeoff_from``: start the jump from a run-up controller's simulated take-off state.
+
+By default a jump starts from a frame of the run clip with the explored features imposed
+(``takeoff.takeoff_state``). ``000`` §6.1.1 instead reaches each take-off state with a run-up
+controller; ``task=runup`` trains one and writes ``takeoff_state.h5``
+(``jt_tasks.runup.state_file``). Setting ``task.takeoff_from`` to
+
+* a ``task=runup`` run id (a nested evaluation, or an outer run: its evaluation with the highest
+  ``goal_reward``, or the run itself for ``search=single``),
+* a folder holding ``takeoff_state.h5``, or the file itself,
+
+makes the jump start from that state: the achieved features become the task's fixed take-off
+features (only ``alpha``, which rotates the suite, is left to search), and ``v_y`` (the jumping
+intention, ``takeoff.takeoff_state``) still replaces the vertical root speed unless it is null.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+FILE = "takeoff_state.h5"
+
+
+def _err(msg: str) -> Exception:
+    from toolkit.errors import JtError
+
+    return JtError(msg)
+
+
+def resolve(ref: str, store_path: Optional[str]) -> Path:
+    """The ``takeoff_state.h5`` that ``task.takeoff_from=ref`` names; a one-line error otherwise."""
+    ref = str(ref).strip()
+    p = Path(ref).expanduser()
+    if "/" in ref or ref.endswith(".h5") or p.exists():
+        f = p if p.suffix == ".h5" else p / FILE
+        if not f.is_file():
+            raise _err(f"task.takeoff_from={ref}: no {FILE} there (make one with: jt run task=runup)")
+        return f.resolve()
+    from toolkit.store.tracking import Store, store_root
+
+    store = Store(store_root(store_path))
+    try:
+        run = store.get_run(ref)
+    except Exception:  # noqa: BLE001 - MLflow raises its own exception types for unknown ids
+        raise _err(f"task.takeoff_from={ref}: no such run in store {store_root(store_path)}") from None
+    own = store.artifact_dir(ref) / FILE
+    if own.is_file():
+        return own
+    kids = store.client.search_runs([run.info.experiment_id], max_results=10000,
+                                    filter_string=f"tags.mlflow.parentRunId = '{ref}'")
+    kids = [k for k in kids if (store.artifact_dir(k.info.run_id) / FILE).is_file()]
+    if not kids:
+        raise _err(f"task.takeoff_from={ref}: run has no {FILE} (is it a task=runup run?)")
+    best = max(kids, key=lambda k: (k.data.metrics.get("goal_reward", 0.0), -int(k.data.tags.get("jt.eval_index", 0))))
+    return store.artifact_dir(best.info.run_id) / FILE
+
+
+def load(path: str | Path, foot: str, v_y: Optional[float]) -> Any:
+    """The ``TakeoffState`` of ``path`` with ``v_y`` imposed; its foot must be the task's."""
+    from jt_tasks.jumping.takeoff import impose
+    from jt_tasks.runup.state_file import read_takeoff_state
+
+    ts = read_takeoff_state(path)
+    if ts.foot != foot:
+        raise _err(f"task.takeoff_from: the run-up took off from the {ts.foot} foot, the task uses "
+                   f"task.foot={foot}; choose one of: {ts.foot}")
+    if v_y is not None:
+        v, w = impose(ts.q[3:7], ts.qd[:3], ts.qd[3:6], {}, None, v_y)
+        ts.qd = np.concatenate([v, w, ts.qd[6:]])
+    return ts
+
+
+def features(path: str | Path, names: tuple[str, ...]) -> dict[str, float]:
+    """The achieved take-off features of ``path`` among ``names`` (``alpha`` is never one)."""
+    from jt_tasks.runup.state_file import read_takeoff_state
+
+    got = read_takeoff_state(path).features
+    return {k: float(got[k]) for k in names if k in got}
