@@ -49,6 +49,14 @@ def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
     for k in w0:
         np.testing.assert_array_equal(np.asarray(w0[k]), np.asarray(g2["policy"][k]))
     assert ev2.metrics.get("strategy_angle", math.nan) == pytest.approx(ev.metrics.get("strategy_angle", math.nan), nan_ok=True)
+    # the learning-curve reader sees the same iterations as the evaluation's history
+    from jt_tasks.jumping import curves
+
+    c = curves.read(tmp_path / "ppo.h5")
+    assert len(c["samples"]) == ev.metrics["iterations"] and c["samples"][-1] == ev.metrics["samples"]
+    assert list(c["bar_height"]) == [v for _, v in ev.history["bar_height"]]
+    assert curves.plot([c], ["tiny"], tmp_path / "curves.png").stat().st_size > 1000
+    assert curves.table([c], ["tiny"]).count("| tiny |") == len(c["samples"])
 
 
 # Stage 2 (task.stage=2): tests/plugins/jt_tasks/jumping/test_stage2.py
