@@ -26,7 +26,7 @@ class Job:
         config: the run config as a plain container (picklable).
         point: parameter values by name.
         ctx: where and how to run it (index, seed, workdir).
-        verbose: print progress lines to stderr (for evaluations run in the driver).
+        verbose: print progress lines to stderr (evaluations that run longer than ``QUIET_S``).
     """
 
     config: dict
@@ -50,12 +50,16 @@ def _task_for(config: dict) -> Any:
     return task
 
 
+QUIET_S = 2.0  #: an evaluation reports progress only once it has run this long (short ones stay quiet)
+
+
 def _printer(index: int) -> Any:
-    last = [0.0]
+    start = time.monotonic()
+    last = [start]
 
     def progress(fraction: float, message: str = "") -> None:
         now = time.monotonic()
-        if now - last[0] >= 1.0 or fraction >= 1.0:
+        if now - start >= QUIET_S and (now - last[0] >= 1.0 or fraction >= 1.0):
             last[0] = now
             print(f"  eval {index}: {100 * fraction:5.1f}% {message}", file=sys.stderr, flush=True)
 

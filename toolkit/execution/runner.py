@@ -197,7 +197,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
                                         tags={"jt.eval_index": str(idx), "jt.seed": str(ctx.seed)})
                 store.log_params(child, {**point, "seed": ctx.seed})
             child_ids.append(child)
-            jobs.append(Job(container, point, ctx, verbose=executor.n_workers == 1))
+            jobs.append(Job(container, point, ctx, verbose=True))
         evs: list[Optional[Evaluation]] = [None] * len(jobs)
         for j, (ev, secs) in executor.imap(run_job, jobs):
             evs[j] = ev

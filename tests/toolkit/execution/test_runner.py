@@ -141,3 +141,18 @@ def test_interrupt_marks_run_killed_with_reason(example_plugin_dir, store_dir):
     con = sqlite3.connect(db)
     reason = con.execute("select value from tags where key='jt.reason'").fetchone()[0]
     assert "sigterm" in reason.lower()
+
+
+def test_long_evaluations_show_progress_even_in_parallel_workers(example_plugin_dir, store_dir):
+    """Progress lines come from evaluations that run longer than QUIET_S, whichever worker runs
+    them (a PPO training in a pool worker is silent for minutes otherwise); short ones stay quiet."""
+    from tests.conftest import run_jt
+
+    common = ["run", "task=quadratic", "search=random", "search.budget=2", "search.batch=2", "executor.workers=2",
+              f"store={store_dir}"]
+    slow = run_jt(*common, "task.sleep=3.0", extra_path=example_plugin_dir)
+    assert slow.returncode == 0, slow.stderr
+    for i in (0, 1):
+        assert f"eval {i}: 100.0% bowl" in slow.stderr
+    fast = run_jt(*common, "task.sleep=0", extra_path=example_plugin_dir)
+    assert fast.returncode == 0 and "% bowl" not in fast.stderr
