@@ -74,30 +74,16 @@ class JumpEnv(gymnasium.Env):
 
     def __init__(self, spec: EnvSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
         import pybullet as pb
-        from omegaconf import OmegaConf
 
+        from jt_tasks.character_env import setup_character
         from toolkit import plugins
 
         super().__init__()
         self.spec_ = spec
         self.render_mode = render_mode
         self._pb = pb
-        sim_cfg = OmegaConf.create(dict(spec.sim))
-        sim_cfg.sim = OmegaConf.merge(sim_cfg.get("sim") or {}, {"contacts": False})
-        sim_name = str((sim_cfg.sim.get("name") if "name" in sim_cfg.sim else None) or "bullet")
-        self.sim = plugins.load("sim", sim_name)(sim_cfg)
-        self.client = self.sim.client
-        self.body = self.sim.character.body_id
-        self.ground = int(getattr(self.sim, "ground_id", -1))
-        self.sim_hz = float(self.sim.params.sim_hz)
-        self.sim.n_substeps = 1
-        self.n_links = pb.getNumJoints(self.body, physicsClientId=self.client)
-        self.masses = np.array([pb.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
-                                for i in range(-1, self.n_links)])
+        setup_character(self, spec.sim, spec.action)
         self.foot_link = FOOT_LINKS[spec.foot]
-        act_cfg = OmegaConf.create(dict(spec.action))
-        self.action_space_ = plugins.load("action", str(act_cfg.name))(act_cfg, "humanoid")
-        self.skeleton = self.action_space_.skeleton
         self.terms = {name: plugins.load("reward", name)(params)
                       for name, params in (spec.reward_terms or {}).items()}
         self.suite = Suite(self.client, spec.suite)
@@ -112,8 +98,6 @@ class JumpEnv(gymnasium.Env):
         self.control_hz = float(spec.control_hz)
         self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)
         self.tracker = CrossingTracker()
-        low, high = self.action_space_.bounds()
-        self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
         self._reset_episode()
         obs = self._obs()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)

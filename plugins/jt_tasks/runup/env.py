@@ -70,36 +70,19 @@ class RunupEnv(gymnasium.Env):
 
     def __init__(self, spec: RunupSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
         import pybullet as pb
-        from omegaconf import OmegaConf
 
-        from toolkit import plugins
+        from jt_tasks.character_env import setup_character
 
         super().__init__()
         self.spec_ = spec
         self.render_mode = render_mode
         self._pb = pb
         self.targets = rw.goal_targets(spec.kind, spec.target, spec.omega_y)
-        sim_cfg = OmegaConf.create(dict(spec.sim))
-        sim_cfg.sim = OmegaConf.merge(sim_cfg.get("sim") or {}, {"contacts": False})
-        sim_name = str((sim_cfg.sim.get("name") if "name" in sim_cfg.sim else None) or "bullet")
-        self.sim = plugins.load("sim", sim_name)(sim_cfg)
-        self.client = self.sim.client
-        self.body = self.sim.character.body_id
-        self.ground = int(getattr(self.sim, "ground_id", -1))
-        self.sim_hz = float(self.sim.params.sim_hz)
-        self.sim.n_substeps = 1
+        setup_character(self, spec.sim, spec.action)
         self.control_hz = float(spec.control_hz)
         self.substeps = max(1, int(round(self.sim_hz / self.control_hz)))
-        self.n_links = pb.getNumJoints(self.body, physicsClientId=self.client)
         self.feet = {FOOT_LINKS["right"], FOOT_LINKS["left"]}
         self.ref = RunReference(spec.clip, spec.foot, spec.contact_tol, spec.foot_clearance, self.sim_hz)
-        self.masses = np.array([pb.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
-                                for i in range(-1, self.n_links)])
-        act_cfg = OmegaConf.create(dict(spec.action))
-        self.action_space_ = plugins.load("action", str(act_cfg.name))(act_cfg, "humanoid")
-        self.skeleton = self.action_space_.skeleton
-        low, high = self.action_space_.bounds()
-        self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
         if seed is not None:
             self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
         self._start(self.ref.t_mid)
