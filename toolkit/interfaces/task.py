@@ -88,6 +88,16 @@ class Task(Plugin, abc.ABC):
     def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
         """Run one evaluation at ``point`` (names of ``problem().space``)."""
 
+    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
+        """A ``gymnasium.Env`` of this task at ``point`` (None: the defaults), for other RL libraries.
+
+        Tasks that train a policy override this; ``toolkit.gym_envs`` exposes it to
+        ``gymnasium.make``. The default says the task has none.
+        """
+        from toolkit.errors import JtError
+
+        raise JtError(f"task {type(self).__name__} has no Gymnasium environment (it does not train a policy)")
+
     def summarize(self, evaluations: Sequence[Evaluation], workdir: Path) -> dict[str, Any]:
         """Run-level metrics over all evaluations; may write files (tables, plots) to ``workdir``.
 

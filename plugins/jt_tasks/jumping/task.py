@@ -185,6 +185,12 @@ class JumpTask(Task):
                        sim=sim, action=action, reward_terms=terms,
                        policy_features=[list(map(float, f)) for f in pol])
 
+    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
+        """The ``JumpEnv`` of take-off features ``point`` (missing: the defaults), bar at ``z_min``."""
+        from jt_tasks.jumping.env import JumpEnv
+
+        return JumpEnv(self.env_spec(dict(point or {})), seed=seed)
+
     def reward_name(self) -> str:
         return self.params.reward + ("_stage2" if self.params.stage == 2 else "")
 

@@ -133,6 +133,12 @@ class RunupTask(Task):
                          check_every=p.check_every, w_imitation=p.w_imitation, w_goal=p.w_goal,
                          goal_steps=p.goal_steps, sim=sim, action=action)
 
+    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
+        """The ``RunupEnv`` with target features ``point`` (missing: the defaults)."""
+        from jt_tasks.runup.env import RunupEnv
+
+        return RunupEnv(self.env_spec(dict(point or {})), seed=seed)
+
     def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
         from jt_tasks.runup.state_file import NAME
         from jt_tasks.runup.train import run_evaluation
