@@ -52,6 +52,10 @@ class PPOConfig:
     """Minibatch size (000 §6.2)."""
     clip: float = 0.02
     """PPO ratio clip threshold ε (000 §6.2)."""
+    target_kl: Optional[float] = None
+    """Stop an iteration's epochs once an epoch's mean approximate KL exceeds this (CleanRL's
+    ``target_kl``); None: always ``epochs`` (the paper). Guards large-step settings (Adam, wide
+    clip) against the overshoots docs/highjump.md shows."""
     policy_lr: float = 2.5e-5
     """Policy learning rate (000 §6.2)."""
     value_lr: float = 1.0e-2
@@ -205,7 +209,8 @@ def ppo_update(
         rng: draws the minibatch permutations.
 
     Returns:
-        Mean policy loss, value loss, clip fraction and approximate KL over all minibatches.
+        Mean policy loss, value loss, clip fraction and approximate KL over all minibatches, and
+        ``epochs_run`` (fewer than ``cfg.epochs`` when ``cfg.target_kl`` stopped the update).
     """
     obs = torch.as_tensor(batch["obs"], dtype=torch.float32)
     act = torch.as_tensor(batch["actions"], dtype=torch.float32)
@@ -220,7 +225,10 @@ def ppo_update(
     n = obs.shape[0]
     sums = {"policy_loss": 0.0, "value_loss": 0.0, "clip_frac": 0.0, "approx_kl": 0.0}
     n_mb = 0
+    epochs_run = 0
     for _ in range(cfg.epochs):
+        epochs_run += 1
+        kl_before, mb_before = sums["approx_kl"], n_mb
         perm = torch.from_numpy(rng.permutation(n))
         for start in range(0, n, cfg.minibatch_size):
             idx = perm[start:start + cfg.minibatch_size]
@@ -250,7 +258,12 @@ def ppo_update(
                 sums["clip_frac"] += float(((ratio - 1.0).abs() > cfg.clip).float().mean())
                 sums["approx_kl"] += float(((ratio - 1.0) - log_ratio).mean())
             n_mb += 1
-    return {k: v / max(n_mb, 1) for k, v in sums.items()}
+        epoch_kl = (sums["approx_kl"] - kl_before) / max(n_mb - mb_before, 1)
+        if cfg.target_kl is not None and epoch_kl > cfg.target_kl:
+            break
+    out = {k: v / max(n_mb, 1) for k, v in sums.items()}
+    out["epochs_run"] = float(epochs_run)
+    return out
 
 
 def _probe(env_fn: Callable[[int], Any], seed: int) -> tuple[int, int, np.ndarray, np.ndarray]:

@@ -150,3 +150,15 @@ def test_training_with_executor_actors_matches_in_process():
         remote = train(ENV, cfg, executor=ex, on_iteration=curriculum)
     assert _learning_stats(remote.history) == _learning_stats(local.history)
     _assert_same_model(_params(remote.model), _params(local.model))
+
+
+def test_target_kl_stops_an_update_early():
+    """``target_kl`` (CleanRL): an epoch whose mean approximate KL exceeds it ends the update, so a
+    tiny threshold leaves one epoch per iteration; None runs them all."""
+    full = train(ENV, tiny(epochs=4, n_workers=1, policy_lr=1e-2, optimizer="adam"))
+    early = train(ENV, tiny(epochs=4, n_workers=1, policy_lr=1e-2, optimizer="adam", target_kl=1e-9))
+    assert full.history["epochs_run"] == [4.0] * 4
+    assert early.history["epochs_run"] == [1.0] * 4
+    assert early.history["mean_return"][0] == full.history["mean_return"][0]  # same first batch
+    loose = train(ENV, tiny(epochs=4, n_workers=1, policy_lr=1e-2, optimizer="adam", target_kl=1e9))
+    assert _learning_stats(loose.history) == _learning_stats(full.history)  # never reached: the paper's loop
