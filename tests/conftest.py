@@ -56,3 +56,14 @@ def run_jt(*args: str, extra_path: Path | None = None, cwd: Path | None = None,
     """Run ``jt ARGS`` as a user would; returns the completed process (text output)."""
     return subprocess.run([sys.executable, "-m", "toolkit.cli", *args], capture_output=True, text=True,
                           env=jt_env(extra_path), cwd=cwd, timeout=timeout)
+
+
+@pytest.fixture()
+def one_torch_thread():
+    """One torch thread for a learner with small nets on 2 shared cores (restored afterwards)."""
+    import torch
+
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)

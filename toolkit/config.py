@@ -270,13 +270,25 @@ def config_of(config_cls: type, cfg: Any, what: str = "config") -> Any:
         raise JtError(f"{what}: {key + ': ' if key else ''}{msg}") from e
 
 
+def group_of(cfg: Any, key: str) -> Any:
+    """The ``key`` group of a run config (DictConfig, dict or attribute object); None if absent."""
+    if cfg is None:
+        return None
+    try:
+        return cfg[key] if key in cfg else None
+    except TypeError:
+        return getattr(cfg, key, None)
+
+
+def plain(node: Any) -> dict:
+    """A config node as a plain, resolved ``dict`` (``{}`` for None) — picklable for workers."""
+    from omegaconf import OmegaConf
+
+    return OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else dict(node or {})
+
+
 def task_params(config_cls: type, cfg: Any) -> Any:
     """A task's typed ``Config`` from the whole run config (its ``task`` group), the group itself,
     or ``None`` (all defaults). Same checks and errors as ``config_of``."""
-    group = cfg
-    if cfg is not None:
-        try:
-            group = cfg["task"] if "task" in cfg else cfg
-        except TypeError:
-            group = getattr(cfg, "task", cfg)
-    return config_of(config_cls, group, "task")
+    task = group_of(cfg, "task")
+    return config_of(config_cls, cfg if task is None else task, "task")

@@ -8,6 +8,7 @@ import os
 import traceback
 from typing import Any, Callable, Iterator, Optional, Sequence
 
+from toolkit.execution.actors import InlineActors
 from toolkit.interfaces import ActorGroup, Executor
 
 
@@ -42,22 +43,6 @@ def _actor_main(conn: Any, factory: Callable[..., Any], args: tuple) -> None:
 class WorkerError(RuntimeError):
     """An exception raised inside a worker process, with the worker's traceback."""
 
-
-class _InlineActors(ActorGroup):
-    def __init__(self, factory: Callable[..., Any], args: Sequence[tuple]) -> None:
-        self._objs = [factory(*a) for a in args]
-        self.size = len(self._objs)
-
-    def call(self, method: str, args: Sequence[tuple] | None = None) -> list[Any]:
-        args = args if args is not None else [()] * self.size
-        return [getattr(o, method)(*a) for o, a in zip(self._objs, args)]
-
-    def close(self) -> None:
-        for o in self._objs:
-            close = getattr(o, "close", None)
-            if callable(close):
-                close()
-        self._objs = []
 
 
 class _ProcessActors(ActorGroup):
@@ -150,7 +135,7 @@ class LocalExecutor(Executor):
 
     def actors(self, factory: Callable[..., Any], args: Sequence[tuple]) -> ActorGroup:
         if self._workers == 1:
-            return _InlineActors(factory, args)
+            return InlineActors(factory, args)
         return _ProcessActors(self._context(), factory, args)
 
     def close(self) -> None:

@@ -202,25 +202,6 @@ class RolloutWorker:
         self.envs = []
 
 
-class InProcessWorkers:
-    """The ``ActorGroup`` call shape over workers living in this process (no executor)."""
-
-    def __init__(self, factory: Callable[..., Any], args: Sequence[tuple]) -> None:
-        self._objs = [factory(*a) for a in args]
-        self.size = len(self._objs)
-
-    def call(self, method: str, args: Sequence[tuple] | None = None) -> list[Any]:
-        """Call ``method`` on every worker in order (worker ``i`` gets ``*args[i]``)."""
-        args = args if args is not None else [()] * self.size
-        return [getattr(o, method)(*a) for o, a in zip(self._objs, args)]
-
-    def close(self) -> None:
-        """Close every worker."""
-        for o in self._objs:
-            o.close()
-        self._objs = []
-
-
 def start_workers(
     env_fn: Callable[[int], Any],
     seed: int,
@@ -243,7 +224,9 @@ def start_workers(
         for w in range(n_workers)
     ]
     if executor is None or n_workers == 1:
-        return InProcessWorkers(RolloutWorker, args)
+        from toolkit.execution.actors import InlineActors
+
+        return InlineActors(RolloutWorker, args)
     return executor.actors(RolloutWorker, args)
 
 

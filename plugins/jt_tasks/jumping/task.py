@@ -18,18 +18,12 @@ import math
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
+from toolkit.config import group_of, plain
 from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
 FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
-
-
-def _group(cfg: Any, key: str) -> Any:
-    try:
-        return cfg[key] if key in cfg else None
-    except TypeError:
-        return getattr(cfg, key, None)
 
 
 def reward_terms_from_conf(name: str) -> dict:
@@ -87,7 +81,7 @@ class JumpTask(Task):
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        group = _group(cfg, "task") if cfg is not None else None
+        group = group_of(cfg, "task")
         params = Plugin.params_of(group) if group is not None else {}
         self.params = self.Config(**params)
         self._stage2: Any = None
@@ -108,7 +102,7 @@ class JumpTask(Task):
         if self._stage2 is None:
             from jt_tasks.jumping.stage2 import resolve
 
-            store = _group(self.cfg, "store") if self.cfg is not None else None
+            store = group_of(self.cfg, "store")
             self._stage2 = resolve(p, str(store) if store is not None else None, str(p.name), self.feature_names)
         return self._stage2
 
@@ -118,7 +112,7 @@ class JumpTask(Task):
         if ref and self._takeoff_file is None:
             from jt_tasks.jumping import takeoff_source
 
-            store = _group(self.cfg, "store") if self.cfg is not None else None
+            store = group_of(self.cfg, "store")
             self._takeoff_file = takeoff_source.resolve(ref, str(store) if store is not None else None)
         return self._takeoff_file if ref else None
 
@@ -146,8 +140,8 @@ class JumpTask(Task):
 
         r, d = self.ranges(), {**self.DEFAULTS, **(self.params.takeoff or {})}
         if self.params.stage == 2:
-            search = _group(self.cfg, "search") if self.cfg is not None else None
-            if search is not None and str(_group(search, "name")) != "single":
+            search = group_of(self.cfg, "search")
+            if search is not None and str(group_of(search, "name")) != "single":
                 from toolkit.errors import JtError
 
                 raise JtError("task.stage=2 trains one policy from task.init: use search=single (the default)")
@@ -159,8 +153,6 @@ class JumpTask(Task):
     # ------------------------------------------------------------------ building blocks
     def env_spec(self, point: dict[str, float]) -> Any:
         """The ``EnvSpec`` for take-off features ``point`` (missing ones: the defaults)."""
-        from omegaconf import OmegaConf
-
         from jt_tasks.jumping.env import EnvSpec
         from jt_tasks.jumping.scene import SuiteSpec
 
@@ -170,11 +162,10 @@ class JumpTask(Task):
         feats = {k: float(feats[k]) for k in self.feature_names}
         suite = SuiteSpec(kind=self.kind, alpha=feats.get("alpha", 0.0), distance=p.distance,
                           obstacle_height=p.obstacle_height, mat_height=p.mat_height)
-        plain = (lambda n: OmegaConf.to_container(n, resolve=True) if OmegaConf.is_config(n) else dict(n or {}))
-        sim = {"sim": plain(_group(cfg, "sim")), "spd": plain(_group(cfg, "spd")) or {"name": p.spd},
-               "character": plain(_group(cfg, "character")) or {"name": "humanoid"}}
-        action = plain(_group(cfg, "action")) or {"name": p.action}
-        reward = _group(cfg, "reward")
+        sim = {"sim": plain(group_of(cfg, "sim")), "spd": plain(group_of(cfg, "spd")) or {"name": p.spd},
+               "character": plain(group_of(cfg, "character")) or {"name": "humanoid"}}
+        action = plain(group_of(cfg, "action")) or {"name": p.action}
+        reward = group_of(cfg, "reward")
         terms = plain(reward)["terms"] if reward is not None else reward_terms_from_conf(self.reward_name())
         init = self.stage2_init()
         pol = init.policy_features if init is not None else (p.policy_features or [])
@@ -197,7 +188,7 @@ class JumpTask(Task):
     def curriculum(self) -> Any:
         from toolkit import plugins
 
-        node = _group(self.cfg, "curriculum")
+        node = group_of(self.cfg, "curriculum")
         name = str(node.name) if node is not None else self.params.curriculum
         return plugins.load("curriculum", name)(node)
 
@@ -212,8 +203,8 @@ class JumpTask(Task):
             from jt_tasks.jumping.stage2 import check_reward
 
             check_reward(spec.reward_terms)
-        out = run_evaluation(spec, self.curriculum(), _group(self.cfg, "agent"), Path(ctx.workdir),
-                             ctx.seed, _group(self.cfg, "executor"), p.filmstrip_frames,
+        out = run_evaluation(spec, self.curriculum(), group_of(self.cfg, "agent"), Path(ctx.workdir),
+                             ctx.seed, group_of(self.cfg, "executor"), p.filmstrip_frames,
                              (p.filmstrip_width, p.filmstrip_height), ctx.progress,
                              warm_start=init.checkpoint if init is not None else None)
         ro, res = out["rollout"], out["result"]

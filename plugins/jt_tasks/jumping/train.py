@@ -44,22 +44,22 @@ def rollout(env: Any, model: Any, frames: int = 0, width: int = 160, height: int
     roots, coms, times, imgs = [], [], [], []
     done, ret, info = False, 0.0, {}
     renders = frames > 0
-    while not done:
+
+    def record() -> None:
         q, _ = env.sim.state()
         roots.append(q[:7].copy())
         coms.append(env._com_and_links()[0])
         times.append(env.t)
         if renders:
             imgs.append(env.render_frame(width, height))
+
+    while not done:
+        record()
         obs, r, te, tr, info = env.step(model.act(obs).astype(np.float32))
         ret += r
         done = te or tr
-    q, _ = env.sim.state()
-    roots.append(q[:7].copy())
-    coms.append(env._com_and_links()[0])
-    times.append(env.t)
+    record()
     if renders:
-        imgs.append(env.render_frame(width, height))
         idx = np.unique(np.linspace(0, len(imgs) - 1, frames).round().astype(int))
         imgs = [imgs[i] for i in idx]
     return {"return": ret, "info": info, "root": np.array(roots), "com": np.array(coms),

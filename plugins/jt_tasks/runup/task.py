@@ -18,24 +18,9 @@ import math
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
-from toolkit.config import task_params
+from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
-
-
-def _group(cfg: Any, key: str) -> Any:
-    if cfg is None:
-        return None
-    try:
-        return cfg[key] if key in cfg else None
-    except TypeError:
-        return getattr(cfg, key, None)
-
-
-def _plain(node: Any) -> dict:
-    from omegaconf import OmegaConf
-
-    return OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else dict(node or {})
 
 
 def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
@@ -124,9 +109,9 @@ class RunupTask(Task):
         _, defaults = self.box()
         feats = {**defaults, **{k: float(v) for k, v in point.items()},
                  **{k: float(v) for k, v in (p.point or {}).items()}}
-        sim = {"sim": _plain(_group(cfg, "sim")), "spd": _plain(_group(cfg, "spd")) or {"name": p.spd},
-               "character": _plain(_group(cfg, "character")) or {"name": "humanoid"}}
-        action = _plain(_group(cfg, "action")) or {"name": p.action}
+        sim = {"sim": plain(group_of(cfg, "sim")), "spd": plain(group_of(cfg, "spd")) or {"name": p.spd},
+               "character": plain(group_of(cfg, "character")) or {"name": "humanoid"}}
+        action = plain(group_of(cfg, "action")) or {"name": p.action}
         return RunupSpec(kind=p.kind, target={k: float(feats[k]) for k in self.feature_names},
                          omega_y=p.omega_y, clip=p.clip, foot=p.foot, n_strides=p.n_strides,
                          contact_tol=p.contact_tol, foot_clearance=p.foot_clearance, control_hz=p.control_hz,
@@ -145,7 +130,7 @@ class RunupTask(Task):
 
         p = self.params
         spec = self.env_spec(point)
-        out = run_evaluation(spec, _group(self.cfg, "agent"), Path(ctx.workdir), ctx.seed, _group(self.cfg, "executor"),
+        out = run_evaluation(spec, group_of(self.cfg, "agent"), Path(ctx.workdir), ctx.seed, group_of(self.cfg, "executor"),
                              p.eval_lead, p.filmstrip_frames, (p.filmstrip_width, p.filmstrip_height), ctx.progress)
         ro, res = out["rollout"], out["result"]
         info = ro["info"]

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, ClassVar, Optional, Sequence
 
 from jt_tasks.spd_tracking.motions import WaveParams
+from toolkit.config import plain
 from toolkit.interfaces import EvalContext, Evaluation, Task
 
 FPS_RATE = {"laikago": 240.0}  #: 001 §2.4.2: dt = 1/240 for the dog, 1/30 otherwise
@@ -77,14 +78,6 @@ class SPDTrackingConfig:
     """The snakes' travelling wave (ours; see jt_tasks.spd_tracking.motions)."""
 
 
-def _plain(cfg: Any) -> dict:
-    from omegaconf import OmegaConf
-
-    if isinstance(cfg, dict):
-        return cfg
-    return OmegaConf.to_container(cfg, resolve=True)
-
-
 class SPDTrackingTask(Task):
     """Mocap tracking with SPD and a hand-of-God root over time steps: error, FPS, SPD share."""
 
@@ -96,7 +89,7 @@ class SPDTrackingTask(Task):
         from toolkit.config import config_of
 
         super().__init__(cfg)
-        whole = _plain(cfg)
+        whole = plain(cfg)
         self.params: SPDTrackingConfig = config_of(SPDTrackingConfig, whole.get("task"), "task")
         self.whole = whole
 

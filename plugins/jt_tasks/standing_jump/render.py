@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -75,12 +75,7 @@ def filmstrip(point: dict[str, float], path: Path, title: str, settings=None, wi
     fig.suptitle(f"{title}: head apex {res.height:.2f} m, "
                  f"{'natural' if res.natural else f'g0 {res.takeoff_gravity:.2f} m/s² for {res.assist_time:.2f} s'}"
                  f"{'' if res.success else ' — FAILED: ' + res.reason}", fontsize=8)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def front_plot(height: np.ndarray, effort: np.ndarray, front: np.ndarray, natural: np.ndarray,
@@ -120,6 +115,13 @@ def front_plot(height: np.ndarray, effort: np.ndarray, front: np.ndarray, natura
     ax.set_ylabel("effort  log(w_JE e_JE + w_SE e_SE)")
     ax.legend(fontsize=7, loc="upper left")
     ax.set_title("Pareto front (004 Fig. 8 analogue)", fontsize=9)
+    return _save(fig, path)
+
+
+def _save(fig: Any, path: str | Path) -> Path:
+    """Lay out, write (creating the folder) and close a matplotlib figure; returns the path."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

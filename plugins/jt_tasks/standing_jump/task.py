@@ -19,17 +19,12 @@ from typing import Any, ClassVar, Sequence
 from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.searcher import SearchProblem
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
-from toolkit.config import task_params
+from toolkit.config import group_of, task_params
 
 
 def _spd_group(cfg: Any) -> dict:
     """The run config's ``spd`` group as a plain dict; ``{"name": "maba"}`` when it has none."""
-    group = None
-    if cfg is not None:
-        try:
-            group = cfg["spd"] if "spd" in cfg else None
-        except TypeError:
-            group = getattr(cfg, "spd", None)
+    group = group_of(cfg, "spd")
     if group is None:
         return {"name": "maba"}
     name = str(group["name"]) if "name" in group else "maba"

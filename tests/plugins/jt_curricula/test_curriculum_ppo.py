@@ -49,14 +49,7 @@ def tiny(**kw):
 CFG = {"z_min": 0.5, "z_max": 1.25, "dz": 0.25, "reward_threshold": 0.9}
 
 
-@pytest.fixture(autouse=True)
-def _one_torch_thread():
-    import torch
-
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def test_curriculum_drives_the_envs_through_the_trainer(tmp_path):
