@@ -38,3 +38,17 @@ def test_bad_input_is_one_line(example_plugin, overrides, expected):
         compose(overrides)
     msg = str(e.value)
     assert expected in msg and "\n" not in msg, msg
+
+
+def test_group_of_and_plain_read_any_run_config_shape():
+    from types import SimpleNamespace
+
+    from omegaconf import OmegaConf
+
+    from toolkit.config import group_of, plain
+
+    node = OmegaConf.create({"sim": {"name": "bullet", "hz": "${x}"}, "x": 600})
+    assert plain(group_of(node, "sim")) == {"name": "bullet", "hz": 600}  # resolved, a plain dict
+    assert group_of({"sim": {"name": "b"}}, "sim") == {"name": "b"}
+    assert group_of(SimpleNamespace(sim=3), "sim") == 3
+    assert group_of(node, "spd") is None and group_of(None, "sim") is None and plain(None) == {}
