@@ -39,7 +39,7 @@ def test_gymnasium_make_passes_the_env_checker(task):
 def test_overrides_and_point_reach_the_environment():
     import gymnasium
 
-    from jt_tasks.jumping.takeoff import facing_velocities
+    from jt_tasks.takeoff.state import facing_velocities
 
     vy = {}
     for override in ("task.v_y=2.06", "task.v_y=null"):

@@ -39,7 +39,7 @@ from gymnasium import spaces
 
 from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
-from jt_tasks.jumping.takeoff import FOOT_LINKS, takeoff_state
+from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
 
 HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index)
 
@@ -89,7 +89,7 @@ class JumpEnv(gymnasium.Env):
         self.suite = Suite(self.client, spec.suite)
         feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
         if spec.takeoff_file:
-            from jt_tasks.jumping import takeoff_source
+            from jt_tasks.takeoff import source as takeoff_source
 
             self.takeoff = takeoff_source.load(spec.takeoff_file, spec.foot, spec.v_y)
         else:

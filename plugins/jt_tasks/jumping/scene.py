@@ -1,7 +1,7 @@
 """The jumping suites (``000`` §6.1): a bar wall or an obstacle box, and a rigid landing mat.
 
 Built with PyBullet in the simulator's own client, in the take-off *facing frame* (the character
-at the origin heading +x, y up, +z its right; ``jt_tasks.jumping.takeoff``).
+at the origin heading +x, y up, +z its right; ``jt_tasks.takeoff.state``).
 
 High jump: "The crossbar is modeled as a rigid wall vertically extending from the ground to the
 target height [...] We model the landing area as a rigid block" (``000`` §6.1). The approach

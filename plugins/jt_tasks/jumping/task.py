@@ -110,7 +110,7 @@ class JumpTask(Task):
         """The run-up's ``takeoff_state.h5`` of ``task.takeoff_from`` (resolved once); None if unset."""
         ref = str(self.params.takeoff_from or "").strip()
         if ref and self._takeoff_file is None:
-            from jt_tasks.jumping import takeoff_source
+            from jt_tasks.takeoff import source as takeoff_source
 
             store = group_of(self.cfg, "store")
             self._takeoff_file = takeoff_source.resolve(ref, str(store) if store is not None else None)
@@ -124,7 +124,7 @@ class JumpTask(Task):
             return dict(init.features)
         fixed = dict(self.params.point or {})
         if self.takeoff_file() is not None:
-            from jt_tasks.jumping import takeoff_source
+            from jt_tasks.takeoff import source as takeoff_source
 
             fixed.update(takeoff_source.features(self.takeoff_file(), self.feature_names))
         return fixed

@@ -36,7 +36,7 @@ import numpy as np
 import gymnasium
 from gymnasium import spaces
 
-from jt_tasks.jumping.takeoff import FOOT_LINKS, heading_quat
+from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat
 from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
 from toolkit.motion import rotations as rot

@@ -4,8 +4,8 @@
 the DeepMimic clip, as the jump tasks do) and answers what the run-up environment asks of it:
 
 * the take-off instant: the middle of a support phase of the take-off foot, found exactly as the
-  jump tasks find it (``jt_tasks.jumping.takeoff.support_phase_time``), repeating once per cycle;
-* the reference state ``(q, qd)`` at any clip time (``takeoff.reference_state``: slerp pose and
+  jump tasks find it (``jt_tasks.takeoff.state.support_phase_time``), repeating once per cycle;
+* the reference state ``(q, qd)`` at any clip time (``jt_tasks.takeoff.state.reference_state``: slerp pose and
   central-difference velocities, the root shifted by the clip's cycle offset on every loop);
 * forward kinematics of a state (link centres of mass, whole-body CoM) by PyBullet, in a private
   DIRECT client holding one kinematic copy of the humanoid (never stepped);
@@ -28,7 +28,7 @@ from typing import Optional
 
 import numpy as np
 
-from jt_tasks.jumping.takeoff import FOOT_LINKS, heading_quat, reference_state, support_phase_time
+from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat, reference_state, support_phase_time
 from toolkit.motion import rotations as rot
 
 #: hands and feet (PyBullet link indices): the end effectors of Peng et al. 2018 §6
@@ -59,7 +59,7 @@ class RunReference:
     Args:
         clip_name: a DeepMimic humanoid clip (``humanoid3d_<name>.txt``) or a path.
         foot: take-off foot, ``right`` or ``left``.
-        contact_tol: a foot within this height (m) of its lowest is on the ground (``takeoff.py``).
+        contact_tol: a foot within this height (m) of its lowest is on the ground (``jt_tasks.takeoff.state``).
         foot_clearance: height (m) of the take-off foot's lowest point at the take-off instant.
         sim_hz: rate of the time grid of ``at``.
     """
@@ -155,20 +155,7 @@ class RunReference:
 
 
 def facing_frame(q: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """``points (..., 3)`` relative to the root of ``q``, in its facing frame (``takeoff.py``)."""
+    """``points (..., 3)`` relative to the root of ``q``, in its facing frame (``jt_tasks.takeoff.state``)."""
     inv = rot.quat_conjugate(heading_quat(np.asarray(q[3:7])))
     return rot.quat_rotate(inv, np.asarray(points) - np.asarray(q[:3]))
 
-
-def normalise_heading(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The state turned about +y so that its heading is +x, its root above the origin.
-
-    As ``takeoff.takeoff_state`` builds its states (height kept; the jump env re-places the foot).
-    Returns ``(q (n_q,), qd (n_dof,))``; joint coordinates and velocities are local and unchanged.
-    """
-    q, qd = np.asarray(q, dtype=float).copy(), np.asarray(qd, dtype=float).copy()
-    inv = rot.quat_conjugate(heading_quat(q[3:7]))
-    q[3:7] = rot.quat_normalize(rot.quat_multiply(inv, q[3:7]))
-    q[0] = q[2] = 0.0
-    qd[:3], qd[3:6] = rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6])
-    return q, qd

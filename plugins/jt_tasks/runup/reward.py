@@ -30,7 +30,7 @@ from toolkit.motion import rotations as rot
 #: DeepMimic's imitation weights and scales (Peng et al. 2018 §6)
 IMITATION_WEIGHTS = {"pose": 0.65, "vel": 0.1, "ee": 0.15, "com": 0.1}
 IMITATION_SCALES = {"pose": 2.0, "vel": 0.1, "ee": 40.0, "com": 10.0}
-#: take-off features measured at the end of the run-up (names as in ``jt_tasks.jumping.takeoff``)
+#: take-off features measured at the end of the run-up (names as in ``jt_tasks.takeoff.state``)
 MEASURED = ("omega_x", "omega_y", "omega_z", "v_z")
 #: the targets of each kind: eq 13 (omega_y fixed, not explored) and eq 14
 GOAL_FEATURES = {"highjump": ("omega_x", "omega_z", "v_z"), "obstacle": ("omega_x", "omega_y", "omega_z")}
@@ -82,7 +82,7 @@ def imitation_terms(skeleton, q_sim: np.ndarray, qd_sim: np.ndarray, ee_sim: np.
 
 def measure(q: np.ndarray, qd: np.ndarray) -> dict[str, float]:
     """Take-off features of a state: root ω (x, y, z) and v_z in the facing frame (``takeoff.py``)."""
-    from jt_tasks.jumping.takeoff import facing_velocities
+    from jt_tasks.takeoff.state import facing_velocities
 
     v, w = facing_velocities(q, qd)
     return {"omega_x": float(w[0]), "omega_y": float(w[1]), "omega_z": float(w[2]), "v_z": float(v[2])}

@@ -125,7 +125,7 @@ class RunupTask(Task):
         return RunupEnv(self.env_spec(dict(point or {})), seed=seed)
 
     def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
-        from jt_tasks.runup.state_file import NAME
+        from jt_tasks.takeoff.state_file import NAME
         from jt_tasks.runup.train import run_evaluation
 
         p = self.params

@@ -81,7 +81,7 @@ def run_evaluation(spec: Any, agent_cfg: Any, workdir: Path, seed: int, executor
 
     from jt_tasks.jumping.train import ppo_config, save_filmstrip
     from jt_tasks.runup.env import EnvFactory, RunupEnv
-    from jt_tasks.runup.state_file import NAME, write_takeoff_state
+    from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
 
     workdir = Path(workdir)
     cfg = ppo_config(agent_cfg, seed)

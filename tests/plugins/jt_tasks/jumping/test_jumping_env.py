@@ -30,7 +30,7 @@ def test_env_checker_highjump_obstacle_longjump():
 
 
 def test_takeoff_state_has_the_imposed_features(env):
-    from jt_tasks.jumping.takeoff import facing_velocities
+    from jt_tasks.takeoff.state import facing_velocities
 
     env.reset(seed=0)
     q, qd = env.sim.state()
@@ -145,3 +145,24 @@ def test_control_rate_maps_onto_substeps(env):
     env.bar_height = 0.7
     env.reset(seed=0)
     assert env.suite.barrier_height == pytest.approx(0.7)
+
+
+@pytest.mark.parametrize("v_y, cleared", [(None, False), (2.06, True)])
+def test_holding_the_takeoff_pose_clears_a_low_bar_only_with_the_jumping_intention(v_y, cleared):
+    """Without the vertical speed the body runs into the 0.5 m wall whatever the pose; with it,
+    simply holding the take-off pose carries the CoM over the bar plane (what makes the
+    curriculum's first level learnable)."""
+    from jt_tasks.jumping.env import JumpEnv
+
+    env = JumpEnv(make_spec(v_y=v_y), seed=0)
+    try:
+        env.reset(seed=0)
+        hold = env.skeleton.joints_to_dofs(env._q0[7:]).astype(np.float32)
+        done, info = False, {}
+        while not done:
+            _, _, done, _, info = env.step(hold)
+        assert bool(info["crossed"]) is cleared
+        if not cleared:
+            assert info["reason"] == "touched the bar"
+    finally:
+        env.close()

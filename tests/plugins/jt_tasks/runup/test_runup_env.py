@@ -65,7 +65,7 @@ def test_takeoff_schedule_is_n_strides_of_take_off_foot_mid_supports():
 
 def test_reference_mid_support_is_where_takeoff_py_puts_it():
     """Outside reference: the take-off foot is lowest (in support) at the take-off instant."""
-    from jt_tasks.jumping.takeoff import FOOT_LINKS
+    from jt_tasks.takeoff.state import FOOT_LINKS
 
     e = make_env(seed=0)
     try:

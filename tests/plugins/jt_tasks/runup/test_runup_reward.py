@@ -38,8 +38,8 @@ def test_goal_reward_analytic_values():
 
 
 def test_goal_reward_is_one_on_a_simulated_state_with_the_target_features():
-    """jumping/takeoff.py builds a state with imposed features; the env measures them back."""
-    from jt_tasks.jumping.takeoff import takeoff_state
+    """takeoff/state.py builds a state with imposed features; the env measures them back."""
+    from jt_tasks.takeoff.state import takeoff_state
     from jt_tasks.runup.reward import goal_reward, measure
 
     e = make_env(seed=0)

@@ -37,9 +37,9 @@ def test_problem_is_the_jump_tasks_take_off_box():
 def test_jt_run_smoke_writes_a_takeoff_state_that_reproduces_its_features(store_dir):
     import h5py
 
-    from jt_tasks.jumping.takeoff import facing_velocities
     from jt_tasks.runup.reward import goal_reward
-    from jt_tasks.runup.state_file import read_takeoff_state
+    from jt_tasks.takeoff.state import facing_velocities
+    from jt_tasks.takeoff.state_file import read_takeoff_state
 
     proc = run_jt("run", "task=runup", "experiment=smoke", f"store={store_dir}", timeout=240)
     assert proc.returncode == 0, proc.stdout + proc.stderr

@@ -11,9 +11,9 @@ from conftest import make_spec
 @pytest.fixture(scope="module")
 def runup_file(tmp_path_factory):
     """A ``takeoff_state.h5`` as ``task=runup`` writes it, from a state with known features."""
-    from jt_tasks.jumping.takeoff import takeoff_state
     from jt_tasks.runup.reward import measure
-    from jt_tasks.runup.state_file import NAME, write_takeoff_state
+    from jt_tasks.takeoff.state import takeoff_state
+    from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
 
     ts = takeoff_state({"omega_x": -1.0, "omega_z": 0.5, "v_z": -1.5})
     q, qd = ts.q.copy(), ts.qd.copy()
@@ -26,7 +26,7 @@ def runup_file(tmp_path_factory):
 
 def test_the_env_starts_from_the_files_state_with_the_jumping_intention(runup_file):
     from jt_tasks.jumping.env import JumpEnv
-    from jt_tasks.jumping.takeoff import facing_velocities
+    from jt_tasks.takeoff.state import facing_velocities
 
     for v_y in (None, 2.06):
         env = JumpEnv(make_spec(takeoff_file=str(runup_file), v_y=v_y), seed=0)

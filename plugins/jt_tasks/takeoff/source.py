@@ -1,9 +1,9 @@
 """``task.takeoff_from``: start the jump from a run-up controller's simulated take-off state.
 
 By default a jump starts from a frame of the run clip with the explored features imposed
-(``takeoff.takeoff_state``). ``000`` §6.1.1 instead reaches each take-off state with a run-up
-controller; ``task=runup`` trains one and writes ``takeoff_state.h5``
-(``jt_tasks.runup.state_file``). Setting ``task.takeoff_from`` to
+(``jt_tasks.takeoff.state.takeoff_state``). ``000`` §6.1.1 instead reaches each take-off state
+with a run-up controller; ``task=runup`` trains one and writes ``takeoff_state.h5``
+(``jt_tasks.takeoff.state_file``). Setting ``task.takeoff_from`` to
 
 * a ``task=runup`` run id (a nested evaluation, or an outer run: its evaluation with the highest
   ``goal_reward``, or the run itself for ``search=single``),
@@ -11,7 +11,8 @@ controller; ``task=runup`` trains one and writes ``takeoff_state.h5``
 
 makes the jump start from that state: the achieved features become the task's fixed take-off
 features (only ``alpha``, which rotates the suite, is left to search), and ``v_y`` (the jumping
-intention, ``takeoff.takeoff_state``) still replaces the vertical root speed unless it is null.
+intention, ``jt_tasks.takeoff.state.takeoff_state``) still replaces the vertical root speed unless
+it is null.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-FILE = "takeoff_state.h5"
+from jt_tasks.takeoff.state_file import NAME
 
 
 def _err(msg: str) -> Exception:
@@ -35,9 +36,9 @@ def resolve(ref: str, store_path: Optional[str]) -> Path:
     ref = str(ref).strip()
     p = Path(ref).expanduser()
     if "/" in ref or ref.endswith(".h5") or p.exists():
-        f = p if p.suffix == ".h5" else p / FILE
+        f = p if p.suffix == ".h5" else p / NAME
         if not f.is_file():
-            raise _err(f"task.takeoff_from={ref}: no {FILE} there (make one with: jt run task=runup)")
+            raise _err(f"task.takeoff_from={ref}: no {NAME} there (make one with: jt run task=runup)")
         return f.resolve()
     from toolkit.store.tracking import Store, store_root
 
@@ -46,22 +47,22 @@ def resolve(ref: str, store_path: Optional[str]) -> Path:
         run = store.get_run(ref)
     except Exception:  # noqa: BLE001 - MLflow raises its own exception types for unknown ids
         raise _err(f"task.takeoff_from={ref}: no such run in store {store_root(store_path)}") from None
-    own = store.artifact_dir(ref) / FILE
+    own = store.artifact_dir(ref) / NAME
     if own.is_file():
         return own
     kids = store.client.search_runs([run.info.experiment_id], max_results=10000,
                                     filter_string=f"tags.mlflow.parentRunId = '{ref}'")
-    kids = [k for k in kids if (store.artifact_dir(k.info.run_id) / FILE).is_file()]
+    kids = [k for k in kids if (store.artifact_dir(k.info.run_id) / NAME).is_file()]
     if not kids:
-        raise _err(f"task.takeoff_from={ref}: run has no {FILE} (is it a task=runup run?)")
+        raise _err(f"task.takeoff_from={ref}: run has no {NAME} (is it a task=runup run?)")
     best = max(kids, key=lambda k: (k.data.metrics.get("goal_reward", 0.0), -int(k.data.tags.get("jt.eval_index", 0))))
-    return store.artifact_dir(best.info.run_id) / FILE
+    return store.artifact_dir(best.info.run_id) / NAME
 
 
 def load(path: str | Path, foot: str, v_y: Optional[float]) -> Any:
     """The ``TakeoffState`` of ``path`` with ``v_y`` imposed; its foot must be the task's."""
-    from jt_tasks.jumping.takeoff import impose
-    from jt_tasks.runup.state_file import read_takeoff_state
+    from jt_tasks.takeoff.state import impose
+    from jt_tasks.takeoff.state_file import read_takeoff_state
 
     ts = read_takeoff_state(path)
     if ts.foot != foot:
@@ -75,7 +76,7 @@ def load(path: str | Path, foot: str, v_y: Optional[float]) -> Any:
 
 def features(path: str | Path, names: tuple[str, ...]) -> dict[str, float]:
     """The achieved take-off features of ``path`` among ``names`` (``alpha`` is never one)."""
-    from jt_tasks.runup.state_file import read_takeoff_state
+    from jt_tasks.takeoff.state_file import read_takeoff_state
 
     got = read_takeoff_state(path).features
     return {k: float(got[k]) for k in names if k in got}

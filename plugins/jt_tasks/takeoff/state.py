@@ -191,6 +191,20 @@ def liftoff_vertical_speed(clip_name: str = "jump") -> float:
     return float(np.max((p[n:, 1] - p[:n, 1]) / (2 * h)))
 
 
+def normalise_heading(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The state turned about +y so that its heading is +x, its root above the origin.
+
+    As ``takeoff_state`` builds its states (height kept; the jump env re-places the foot).
+    Returns ``(q (n_q,), qd (n_dof,))``; joint coordinates and velocities are local and unchanged.
+    """
+    q, qd = np.asarray(q, dtype=float).copy(), np.asarray(qd, dtype=float).copy()
+    inv = rot.quat_conjugate(heading_quat(q[3:7]))
+    q[3:7] = rot.quat_normalize(rot.quat_multiply(inv, q[3:7]))
+    q[0] = q[2] = 0.0
+    qd[:3], qd[3:6] = rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6])
+    return q, qd
+
+
 def facing_velocities(q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Root linear and angular velocity ``(3,), (3,)`` in the facing frame of state ``(q, qd)``."""
     inv = rot.quat_conjugate(heading_quat(np.asarray(q[3:7])))

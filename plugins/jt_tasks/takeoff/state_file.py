@@ -8,7 +8,7 @@ name               shape       meaning
 ``q``              ``(n_q,)``  generalised positions, ``toolkit.dynamics`` layout (root x, y, z,
                                quaternion x, y, z, w, then the joints' quaternions / angles),
                                turned about +y so that the heading is +x and the root stands
-                               above the origin: the convention of ``jt_tasks.jumping.takeoff``'s
+                               above the origin: the convention of ``jt_tasks.takeoff.state``'s
                                ``TakeoffState.q`` (the jump env re-places the take-off foot)
 ``qd``             ``(n_dof,)`` generalised velocities in the same frame (root linear and angular
                                velocity, then local joint angular velocities / angle rates)
@@ -37,7 +37,7 @@ NAME = "takeoff_state.h5"
 def write_takeoff_state(path: str | Path, q_world: np.ndarray, qd_world: np.ndarray, features: Mapping[str, float],
                         targets: Mapping[str, float], foot: str, kind: str, time: float, r_goal: float) -> Path:
     """Write the file described above; ``q``/``qd`` are derived from the world state."""
-    from jt_tasks.runup.reference import normalise_heading
+    from jt_tasks.takeoff.state import normalise_heading
     from toolkit.store import h5
 
     q, qd = normalise_heading(q_world, qd_world)
@@ -50,8 +50,8 @@ def write_takeoff_state(path: str | Path, q_world: np.ndarray, qd_world: np.ndar
 
 
 def read_takeoff_state(path: str | Path) -> Any:
-    """The file as a ``jt_tasks.jumping.takeoff.TakeoffState`` (features = the achieved ones)."""
-    from jt_tasks.jumping.takeoff import TakeoffState
+    """The file as a ``jt_tasks.takeoff.state.TakeoffState`` (features = the achieved ones)."""
+    from jt_tasks.takeoff.state import TakeoffState
     from toolkit.store import h5
 
     d = h5.read(Path(path))
