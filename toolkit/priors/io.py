@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 from pathlib import Path
 from typing import Any, Optional
 
@@ -30,7 +29,6 @@ from toolkit.priors.model import KINDS, PosePrior
 FORMAT = "jt.pose_prior"
 VERSION = 1
 FILENAME = "prior.h5"
-_RUN_ID = re.compile(r"^[0-9a-f]{32}$")
 
 
 def how_to_make(kind: str = "pvae") -> str:
@@ -141,38 +139,29 @@ def _check_shapes(p: PosePrior) -> None:
         raise ValueError(f"the encoder gives {mu.shape[-1]} latents, latent_dim is {k}")
 
 
+def _find(ref: str, store_root: Optional[str], kind: str) -> Path:
+    """The prior file ``action.prior=ref`` names (``toolkit.store.resolve``): ``prior.h5``, else any
+    pose prior file, in a folder or one folder down, or among a run's (or its nested runs') artifacts."""
+    from toolkit.store.resolve import resolve
+
+    return resolve(ref, artifact=FILENAME, store=store_root, what="action.prior", label="pose prior",
+                   hint=how_to_make(kind), accept=_is_prior_file).path
+
+
 def find_in_run(run_id: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
-    """The prior file among the artifacts of MLflow run ``run_id`` (or of its child runs).
+    """The prior file among the artifacts of MLflow run ``run_id`` (else of its nested runs).
 
     Raises:
         JtError: no store, no such run, or no prior among its artifacts.
     """
-    from toolkit.store.tracking import Store
-    from toolkit.store.tracking import store_root as resolve_root
-
-    root = resolve_root(store_root)
-    if not (root / "mlflow.db").is_file():
-        raise JtError(f"no pose prior '{run_id}': not a file, and there is no store at {root}; {how_to_make(kind)}")
-    store = Store(root)
-    try:
-        run = store.get_run(run_id)
-    except JtError as e:
-        raise JtError(f"no pose prior '{run_id}': not a file, and {e}; {how_to_make(kind)}") from None
-    dirs = [store.artifact_dir(run_id)]
-    children = store.client.search_runs([run.info.experiment_id], filter_string=f"tags.mlflow.parentRunId = '{run_id}'")
-    dirs += [store.artifact_dir(c.info.run_id) for c in children]
-    found = []
-    for d in dirs:
-        if d.is_dir():
-            found += [p for p in sorted(d.rglob("*.h5")) if _is_prior_file(p)]
-    if not found:
-        raise JtError(f"run {run_id} has no pose prior ({FILENAME}) among its artifacts; {how_to_make(kind)}")
-    named = [p for p in found if p.name == FILENAME]
-    return (named or found)[0]
+    return _find(str(run_id), store_root, kind)
 
 
 def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] = None) -> PosePrior:
     """Load a prior from a file path, a folder holding one, or the id of the MLflow run that made it.
+
+    A folder is searched for ``prior.h5`` (else any pose prior file) in it and one folder down, no
+    deeper; a run id as ``toolkit.store.resolve`` does (its own artifacts, else its nested runs').
 
     Args:
         ref: path to a ``prior.h5`` (or a folder with one), or an MLflow run id.
@@ -186,13 +175,4 @@ def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] =
     if not text:
         need = kind or "pvae"
         raise JtError(f"action={need} needs a pose prior (action.prior=RUN_ID or PATH); {how_to_make(need)}")
-    path = Path(text).expanduser()
-    if path.is_dir():
-        cands = [p for p in sorted(path.rglob("*.h5")) if _is_prior_file(p)]
-        if not cands:
-            raise JtError(f"no pose prior in {path}; {how_to_make(kind or 'pvae')}")
-        named = [p for p in cands if p.name == FILENAME]
-        return read_prior((named or cands)[0], kind)
-    if path.exists() or not _RUN_ID.match(text):
-        return read_prior(path, kind)
-    return read_prior(find_in_run(text, store_root, kind or "pvae"), kind)
+    return read_prior(_find(text, store_root, kind or "pvae"), kind)

@@ -72,10 +72,6 @@ def _err(msg: str) -> Exception:
     return JtError(msg)
 
 
-def _is_path(init: str) -> bool:
-    return "/" in init or init.endswith(".h5") or Path(init).expanduser().exists()
-
-
 def _feature(metrics: dict) -> Optional[list]:
     """``feature_q0..3`` of a run's metrics, None when absent (the jump never crossed the plane)."""
     if not all(k in metrics and math.isfinite(float(metrics[k])) for k in FEATURE_KEYS):
@@ -83,48 +79,37 @@ def _feature(metrics: dict) -> Optional[list]:
     return [float(metrics[k]) for k in FEATURE_KEYS]
 
 
-def _pick(store: Any, run: Any, init_eval: int) -> Any:
-    """The evaluation run of ``run``: itself, or its nested child ``init_eval`` / the best one."""
-    if "mlflow.parentRunId" in run.data.tags:
-        return run
-    rid = run.info.run_id
-    kids = store.client.search_runs([run.info.experiment_id],
-                                    filter_string=f"tags.mlflow.parentRunId = '{rid}'", max_results=10000)
-    kids = [k for k in kids if "jt.eval_index" in k.data.tags]
-    if not kids:
-        if init_eval >= 0:
-            raise _err(f"task.init_eval={init_eval}: run {rid} has no nested evaluations")
-        return run
-    by_index = {int(k.data.tags["jt.eval_index"]): k for k in kids}
-    if init_eval >= 0:
-        if init_eval not in by_index:
-            raise _err(f"task.init_eval={init_eval}: run {rid} has evaluations {sorted(by_index)}")
-        return by_index[init_eval]
-
-    def rank(i: int) -> tuple:
-        m = by_index[i].data.metrics
-        return (-(m.get("failed", 1.0) == 0.0), -m.get("final_success", 0.0),
-                -m.get("bar_height_reached", 0.0), -m.get("mean_return", 0.0), i)
-
-    return by_index[min(by_index, key=rank)]
+def _rank(run: Any) -> tuple:
+    """How good a Stage-1 evaluation is (larger is better; ``resolve`` breaks ties by lower index)."""
+    m = run.data.metrics
+    return (m.get("failed", 1.0) == 0.0, m.get("final_success", 0.0), m.get("bar_height_reached", 0.0),
+            m.get("mean_return", 0.0))
 
 
 def _source(store: Any, init: str, init_eval: int) -> tuple[Any, str]:
-    """``(evaluation run or None, canonical source)`` of ``task.init`` / ``task.init_eval``."""
-    if _is_path(init):
-        p = Path(init).expanduser().resolve()
-        return None, str(p.parent if p.suffix == ".h5" else p)
-    ev = _pick(store, store.get_run(init), init_eval)
-    return ev, ev.info.run_id
+    """``(Resolved, canonical source)`` of ``task.init`` / ``task.init_eval`` (``toolkit.store.resolve``).
+
+    ``store`` is the store's path or an open ``Store``; the source is the evaluation's run id, or
+    the folder holding the ``ppo.h5``.
+    """
+    from toolkit.store.resolve import resolve as find
+
+    got = find(init, artifact="ppo.h5", store=store, best_by=_rank, eval_index=init_eval, what="task.init",
+               label="trained policy", hint="give a Stage-1 jumping run or evaluation", index_what="task.init_eval")
+    return got, got.run_id if got.run is not None else str(got.folder)
 
 
 def _previous_stage2(store: Any, experiment: str, source: str) -> list[tuple[str, list]]:
-    """``(run id, feature)`` of the FINISHED Stage-2 runs of ``experiment`` started from ``source``."""
-    exp = store.client.get_experiment_by_name(experiment)
+    """``(run id, feature)`` of the FINISHED Stage-2 runs of ``experiment`` started from ``source``.
+
+    ``store`` is an open ``Store`` or None (no store yet: no earlier runs).
+    """
+    from toolkit.store.resolve import search_runs
+
+    exp = store.client.get_experiment_by_name(experiment) if store is not None else None
     if exp is None:
         return []
-    runs = store.client.search_runs([exp.experiment_id], max_results=10000,
-                                    filter_string="params.`task.stage` = '2' and attributes.status = 'FINISHED'")
+    runs = search_runs(store, [exp.experiment_id], params={"task.stage": "2"}, status="FINISHED")
     out = []
     for r in sorted(runs, key=lambda r: r.info.start_time):
         init = r.data.params.get("task.init", "")
@@ -148,16 +133,16 @@ def resolve(params: Any, store_path: str, experiment: str, feature_names: tuple)
         feature_names: take-off features of the task.
     """
     from toolkit.store import h5
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.resolve import open_store
 
     init = str(params.init or "").strip()
     if not init:
         raise _err("task.stage=2 needs task.init=<RUN_ID of a Stage-1 run or evaluation> (000 §5.2)")
-    store = Store(store_root(store_path))
-    ev, source = _source(store, init, int(params.init_eval))
+    store = open_store(store_path)  # None: no store yet (a folder init); never created here
+    got, source = _source(store if store is not None else store_path, init, int(params.init_eval))
     own: Optional[list] = None
-    if ev is None:  # a folder
-        folder = Path(source)
+    if got.run is None:  # a folder, or a file in it
+        folder = got.folder
         ckpt, ro = folder / "ppo.h5", folder / "rollout.h5"
         if not ckpt.is_file() or not ro.is_file():
             raise _err(f"task.init={init}: needs ppo.h5 and rollout.h5 in {folder}")
@@ -170,20 +155,18 @@ def resolve(params: Any, store_path: str, experiment: str, feature_names: tuple)
         own = q if len(q) == 4 and all(math.isfinite(x) for x in q) else None
         run_id, index = "", -1
     else:
-        run_id, m = ev.info.run_id, ev.data.metrics
+        ev = got.run
+        run_id, m = got.run_id, ev.data.metrics
         if ev.data.params.get("task.stage", "1") == "2":
             raise _err(f"task.init={init} is a Stage-2 run; start from its Stage-1 init "
                        f"{ev.data.params.get('task.init', '?')}")
-        ckpt = store.artifact_dir(run_id) / "ppo.h5"
-        if not ckpt.is_file():
-            raise _err(f"task.init={init}: run {run_id} has no trained policy (no ppo.h5 artifact); "
-                       "give a Stage-1 jumping run or evaluation")
+        ckpt = got.path
         feats = {k: float(m[f"takeoff_{k}"]) for k in feature_names if f"takeoff_{k}" in m}
         for k in feature_names:  # nested evaluations also carry their point as params
             if k not in feats and k in ev.data.params:
                 feats[k] = float(ev.data.params[k])
         own = _feature(m)
-        index = int(ev.data.tags.get("jt.eval_index", -1))
+        index = got.eval_index
     missing = [k for k in feature_names if k not in feats]
     if missing:
         raise _err(f"task.init={init}: no take-off {', '.join(missing)} recorded (not a {experiment} run?)")

@@ -7,7 +7,8 @@ with a run-up controller; ``task=runup`` trains one and writes ``takeoff_state.h
 
 * a ``task=runup`` run id (a nested evaluation, or an outer run: its evaluation with the highest
   ``goal_reward``, or the run itself for ``search=single``),
-* a folder holding ``takeoff_state.h5``, or the file itself,
+* a folder holding ``takeoff_state.h5`` (or one folder down), or the file itself
+  (``toolkit.store.resolve``),
 
 makes the jump start from that state: the achieved features become the task's fixed take-off
 features (only ``alpha``, which rotates the suite, is left to search), and ``v_y`` (the jumping
@@ -31,32 +32,22 @@ def _err(msg: str) -> Exception:
     return JtError(msg)
 
 
-def resolve(ref: str, store_path: Optional[str]) -> Path:
-    """The ``takeoff_state.h5`` that ``task.takeoff_from=ref`` names; a one-line error otherwise."""
-    ref = str(ref).strip()
-    p = Path(ref).expanduser()
-    if "/" in ref or ref.endswith(".h5") or p.exists():
-        f = p if p.suffix == ".h5" else p / NAME
-        if not f.is_file():
-            raise _err(f"task.takeoff_from={ref}: no {NAME} there (make one with: jt run task=runup)")
-        return f.resolve()
-    from toolkit.store.tracking import Store, store_root
+def _goal_reward(run: Any) -> float:
+    """Which run-up evaluation is best: the highest ``goal_reward`` (r_G, ``000`` eq 13 / 14)."""
+    return run.data.metrics.get("goal_reward", 0.0)
 
-    store = Store(store_root(store_path))
-    try:
-        run = store.get_run(ref)
-    except Exception:  # noqa: BLE001 - MLflow raises its own exception types for unknown ids
-        raise _err(f"task.takeoff_from={ref}: no such run in store {store_root(store_path)}") from None
-    own = store.artifact_dir(ref) / NAME
-    if own.is_file():
-        return own
-    kids = store.client.search_runs([run.info.experiment_id], max_results=10000,
-                                    filter_string=f"tags.mlflow.parentRunId = '{ref}'")
-    kids = [k for k in kids if (store.artifact_dir(k.info.run_id) / NAME).is_file()]
-    if not kids:
-        raise _err(f"task.takeoff_from={ref}: run has no {NAME} (is it a task=runup run?)")
-    best = max(kids, key=lambda k: (k.data.metrics.get("goal_reward", 0.0), -int(k.data.tags.get("jt.eval_index", 0))))
-    return store.artifact_dir(best.info.run_id) / NAME
+
+def resolve(ref: str, store_path: Optional[str]) -> Path:
+    """The ``takeoff_state.h5`` that ``task.takeoff_from=ref`` names; a one-line error otherwise.
+
+    Args:
+        ref: a ``task=runup`` run id (see the module docstring), a folder holding the file, or the file.
+        store_path: the store to look run ids up in (``toolkit.store.tracking.store_root`` rules).
+    """
+    from toolkit.store.resolve import resolve as find
+
+    return find(ref, artifact=NAME, store=store_path, best_by=_goal_reward, what="task.takeoff_from",
+                label="take-off state", hint="is it a task=runup run? make one with: jt run task=runup").path
 
 
 def load(path: str | Path, foot: str, v_y: Optional[float]) -> Any:

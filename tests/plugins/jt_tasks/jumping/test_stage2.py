@@ -117,7 +117,7 @@ def test_pi_collects_earlier_stage2_runs_of_the_same_evaluation(stage1):
 
 @pytest.mark.parametrize("extra, match", [
     (["task.stage=2"], "needs task.init"),
-    (["task.stage=2", "task.init=0123456789abcdef0123456789abcdef"], "no run"),
+    (["task.stage=2", "task.init=0123456789abcdef0123456789abcdef"], "no such run"),
     (["task.stage=2", "task.init=OUTER", "task.init_eval=5"], "init_eval=5"),
     (["task.stage=2", "task.init=EMPTY"], "no trained policy"),
     (["task.init=OUTER"], "add task.stage=2"),

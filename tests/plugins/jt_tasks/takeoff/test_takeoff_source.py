@@ -79,14 +79,15 @@ def test_resolve_a_folder_a_file_and_a_run(state_file, tmp_path):
     assert source.resolve(single, str(tmp_path)) == store.artifact_dir(single) / "takeoff_state.h5"
 
 
-@pytest.mark.parametrize("ref, message", [("0" * 32, "no such run in store"), ("/no/where", "no takeoff_state.h5 there")])
-def test_resolve_errors_are_one_line(ref, message, tmp_path):
+@pytest.mark.parametrize("ref, message", [("0" * 32, "no such run"), ("/no/where", "no takeoff_state.h5 there")])
+def test_resolve_errors_are_one_line_and_create_no_store(ref, message, tmp_path):
     from jt_tasks.takeoff import source
     from toolkit.errors import JtError
 
     with pytest.raises(JtError, match=message) as e:
-        source.resolve(ref, str(tmp_path))
-    assert "\n" not in str(e.value)
+        source.resolve(ref, str(tmp_path / "store"))
+    assert "\n" not in str(e.value) and "task.takeoff_from=" in str(e.value)
+    assert not (tmp_path / "store").exists()
 
 
 def test_a_run_without_the_file_says_so(tmp_path):
@@ -97,5 +98,5 @@ def test_a_run_without_the_file_says_so(tmp_path):
     store = Store(tmp_path)
     rid = store.start_run("highjump")
     store.end_run(rid)
-    with pytest.raises(JtError, match="run has no takeoff_state.h5 .is it a task=runup run"):
+    with pytest.raises(JtError, match=r"no take-off state \(no takeoff_state.h5 artifact\); is it a task=runup run"):
         source.resolve(rid, str(tmp_path))
