@@ -1,9 +1,10 @@
 """PPO as used by the athletic-jumping papers (000 §4.1, §6.2; 001 §3.4.1), in one readable file.
 
-Read top to bottom: ``PPOConfig`` (every hyper-parameter, with its source), the exploration-noise
-schedule, GAE(λ)/TD(λ), the clipped-surrogate update, and ``train`` (collect → estimate → update →
-checkpoint). Rollouts are collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either as
-executor actors or in this process; checkpoints are HDF5 files (``toolkit/rl/checkpoint.py``).
+Read top to bottom: the exploration-noise schedule, GAE(λ)/TD(λ), the clipped-surrogate
+update, and ``train`` (collect → estimate → update → checkpoint). Every hyper-parameter, with its
+source, is in ``PPOConfig`` (``toolkit/rl/config.py``, torch-free, re-exported here). Rollouts are
+collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either as executor actors or in this
+process; checkpoints are HDF5 files (``toolkit/rl/checkpoint.py``).
 
 Sources cited below: ``000`` = Yin et al. 2021 (the paper), ``001`` = Yang's thesis ch. 3 (the same
 work), ``code`` = the authors' public code (arpspoof/Jump, ``presets/default/...``), consulted where
@@ -24,87 +25,11 @@ import torch
 from torch import nn
 
 from toolkit.rl import checkpoint as ckpt
+from toolkit.rl.config import PPOConfig
 from toolkit.rl.networks import ActorCritic, RunningObsStats, gaussian_log_prob
 from toolkit.rl.rollout import merge_batches, start_workers
 
-
-@dataclasses.dataclass
-class PPOConfig:
-    """Every PPO hyper-parameter; defaults are the jumping papers' values."""
-
-    policy_hidden: tuple[int, ...] = (1024, 512)
-    """Policy MLP hidden sizes, ReLU (000 §4.1 "two hidden layers with 1024 and 512 units")."""
-    value_hidden: tuple[int, ...] = (1024, 512)
-    """Value MLP hidden sizes; one linear output unit (000 §4.1 "similar to the policy network")."""
-    std_start: float = 0.5
-    """Fixed (not learned) action std at the start of training (000 §4.1, Σ = σI, σ: 0.5 → 0.1)."""
-    std_end: float = 0.1
-    """Action std after the annealing period (000 §4.1)."""
-    std_anneal_samples: float = 1.0e7
-    """Samples over which σ decreases linearly, then stays at ``std_end`` (000 §4.1 "first 1.0×10^7
-    simulation steps")."""
-    samples_per_iteration: int = 4096
-    """State-action samples collected per iteration (000 §6.2); rounded up to a whole number of
-    steps per environment."""
-    epochs: int = 5
-    """Passes over each batch (000 §6.2 "five policy updates"; code: ``epoch_size: 5``)."""
-    minibatch_size: int = 256
-    """Minibatch size (000 §6.2)."""
-    clip: float = 0.02
-    """PPO ratio clip threshold ε (000 §6.2)."""
-    target_kl: Optional[float] = None
-    """Stop an iteration's epochs once an epoch's mean approximate KL exceeds this (CleanRL's
-    ``target_kl``); None: always ``epochs`` (the paper). Guards large-step settings (Adam, wide
-    clip) against the overshoots docs/highjump.md shows."""
-    policy_lr: float = 2.5e-5
-    """Policy learning rate (000 §6.2)."""
-    value_lr: float = 1.0e-2
-    """Value learning rate (000 §6.2)."""
-    optimizer: str = "sgd"
-    """``sgd`` (with momentum) or ``adam``; separate optimisers for policy and value. The paper does
-    not name it; the authors' code uses SGD with momentum (code ``ppo.yaml``), as DeepMimic does."""
-    momentum: float = 0.9
-    """SGD momentum (code ``actor_momentum``/``critic_momentum: 0.9``; paper silent)."""
-    weight_decay: float = 5.0e-4
-    """L2 weight decay of both optimisers (code ``actor_wdecay``/``critic_wdecay``; paper silent)."""
-    max_grad_norm: float = 100.0
-    """Gradient-norm clip per network; 0 disables (code ``max_grad_norm: 100``; paper silent)."""
-    gamma: float = 1.0
-    """Discount factor (000 §6.2 "short horizon and sparse rewards")."""
-    lam: float = 0.95
-    """λ of both TD(λ) value targets and GAE(λ) advantages (000 §6.2)."""
-    norm_adv: bool = True
-    """Standardise advantages over each batch (code; paper silent)."""
-    adv_clip: float = 4.0
-    """Clip standardised advantages to ±this; 0 disables (code; paper silent)."""
-    obs_norm: bool = True
-    """Running mean/std observation normalisation (DeepMimic lineage; code ``Normalizer``)."""
-    obs_norm_max_samples: int = 1_000_000
-    """Samples after which the normaliser's statistics freeze (code ``sample_lim``)."""
-    normalize_actions: bool = False
-    """False: the policy acts in the env's units and actions are clipped to its Box (as in the
-    code, where σ is in raw action units); True: ``[-1, 1]`` mapped affinely onto the Box."""
-    reward_scale: float = 1.0
-    """Rewards are multiplied by this for learning only (reported returns stay raw); jt default 1."""
-    reset_each_iteration: bool = True
-    """Start new seeded episodes at every iteration (cut episodes are bootstrapped like time
-    limits). Makes a resumed run bit-identical to an uninterrupted one; False lets episodes run on
-    across iterations (a resume then restarts episodes). jt choice, see docs/ppo.md."""
-    total_samples: int = 100_000_000
-    """Training budget in samples (not stated in 000; tasks set their own)."""
-    checkpoint_every: int = 100
-    """Iterations between checkpoints (code ``checkpoint_every_iteration: 100``); also at the end."""
-    seed: int = 0
-    """Run seed: network init, minibatch order, every environment and action-noise seed."""
-    n_workers: int = 1
-    """Rollout workers (executor actors). With ``envs_per_worker`` it fixes the seed layout, so
-    results do not depend on the executor."""
-    envs_per_worker: int = 16
-    """Environments per worker, stepped in lock-step (16 → 256 steps each per iteration)."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-able dict (tuples become lists)."""
-        return json.loads(json.dumps(dataclasses.asdict(self)))
+__all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "compute_gae", "ppo_update", "train"]
 
 
 class IterationStats(dict):
@@ -294,7 +219,7 @@ def train(
 
     Args:
         env_fn: picklable ``env_fn(seed) -> gymnasium.Env`` (continuous Box actions).
-        cfg: hyper-parameters.
+        cfg: hyper-parameters (range-checked first: ``PPOConfig.check``).
         executor: a ``jt.executors`` plugin; its ``actors`` hold the rollout workers. None (or
             ``cfg.n_workers == 1``) runs them in this process, with identical results.
         checkpoint_path: HDF5 checkpoint written every ``cfg.checkpoint_every`` iterations and at
@@ -315,7 +240,11 @@ def train(
 
     Returns:
         The trained model, counters, history and ``extra``.
+
+    Raises:
+        toolkit.errors.JtError: a bad ``cfg`` value.
     """
+    cfg.check()
     extra = {} if extra is None else extra
     obs_dim, act_dim, low, high = _probe(env_fn, cfg.seed)
     torch.manual_seed(cfg.seed)
@@ -423,7 +352,7 @@ def train(
                 if attrs:
                     env_attrs.update(attrs)
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)
-            if path is not None and iteration % max(cfg.checkpoint_every, 1) == 0:
+            if path is not None and iteration % cfg.checkpoint_every == 0:
                 saved = save()
             if should_stop is not None and should_stop():
                 break
