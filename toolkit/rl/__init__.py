@@ -16,6 +16,8 @@ _EXPORTS = {
     "action_std": "toolkit.rl.ppo",
     "compute_gae": "toolkit.rl.ppo",
     "train": "toolkit.rl.ppo",
+    "architecture_of": "toolkit.rl.checkpoint",
+    "with_architecture": "toolkit.rl.checkpoint",
 }
 
 __all__ = sorted(_EXPORTS)

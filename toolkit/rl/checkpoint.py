@@ -13,23 +13,33 @@ lists, arrays, tensors and scalars losslessly and reads them back with their typ
                    env_ids, seed and next seed_offset of the rollout workers
     /env_attrs     attributes last set on every environment (re-applied on resume)
     /extra         free-form caller state (e.g. a curriculum's)
-    attrs: config (JSON of PPOConfig), obs_dim, act_dim, low, high, format
+    attrs: config (JSON of PPOConfig), obs_dim, act_dim, low, high, format, and warm_start
+           (the checkpoint a warm-started run started from) if any
 
 ``save`` writes ``path.tmp``, fsyncs it and ``os.replace``s it onto ``path``, so a crash never
 leaves a half-written checkpoint behind. (``toolkit.store.h5`` is not used: it reads back plain
 numpy dicts, while optimiser states need int keys, tuples, None and tensors back exactly.)
+
+The training glue (what ``toolkit.rl.ppo.train`` saves, resumes and warm-starts from) is at the
+end: ``save_training``, ``load_training``, ``load_networks``, and for warm starts
+``architecture_of``, ``with_architecture`` and ``load_warm_start``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Optional
 
 import h5py
 import numpy as np
 import torch
+
+if TYPE_CHECKING:
+    from toolkit.rl.config import PPOConfig
+    from toolkit.rl.networks import ActorCritic, RunningObsStats
 
 FORMAT = "jt.ppo.checkpoint/1"
 _INT_KEY = "#int:"
@@ -138,18 +148,45 @@ def save(path: str | os.PathLike, groups: dict[str, Any], attrs: dict[str, Any])
     return path
 
 
+def _decode_attrs(f: h5py.File, path: str | os.PathLike) -> dict[str, Any]:
+    if f.attrs.get("format") != FORMAT:
+        raise ValueError(f"{path}: not a jt PPO checkpoint (format {f.attrs.get('format')!r})")
+    attrs: dict[str, Any] = {}
+    for k, v in f.attrs.items():
+        if isinstance(v, str) and v[:1] in "{[":
+            v = json.loads(v)
+        attrs[k] = v.tolist() if isinstance(v, np.ndarray) else v
+    return attrs
+
+
 def load(path: str | os.PathLike) -> tuple[dict[str, Any], dict[str, Any]]:
     """Read a checkpoint: ``(groups, attrs)`` as given to ``save`` (JSON attrs decoded)."""
     with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{path}: not a jt PPO checkpoint (format {f.attrs.get('format')!r})")
-        attrs: dict[str, Any] = {}
-        for k, v in f.attrs.items():
-            if isinstance(v, str) and v[:1] in "{[":
-                v = json.loads(v)
-            attrs[k] = v.tolist() if isinstance(v, np.ndarray) else v
+        attrs = _decode_attrs(f, path)
         groups = {k: read_tree(f[k]) for k in f.keys()}
     return groups, attrs
+
+
+def load_attrs(path: str | os.PathLike) -> dict[str, Any]:
+    """Only the attributes of a checkpoint (config, sizes, bounds), without reading the groups."""
+    with h5py.File(path, "r") as f:
+        return _decode_attrs(f, path)
+
+
+def load_networks(groups: dict[str, Any], model: ActorCritic, obs_stats: Optional[RunningObsStats] = None) -> None:
+    """Copy a checkpoint's policy, value network and observation normaliser into ``model``.
+
+    Args:
+        groups: ``load(path)[0]``.
+        model: an ``ActorCritic`` of the checkpoint's sizes.
+        obs_stats: also restore the normaliser's running statistics (count, sums) into this.
+    """
+    model.pi.load_state_dict(groups["policy"])
+    model.v.load_state_dict(groups["value"])
+    norm = groups["obs_norm"]
+    model.norm.load_state_dict({"mean": torch.as_tensor(norm["mean"]), "std": torch.as_tensor(norm["std"])})
+    if obs_stats is not None:
+        obs_stats.load_state(norm)
 
 
 def load_policy(path: str | os.PathLike) -> Any:
@@ -162,8 +199,156 @@ def load_policy(path: str | os.PathLike) -> Any:
         int(attrs["obs_dim"]), int(attrs["act_dim"]), cfg["policy_hidden"], cfg["value_hidden"],
         np.asarray(attrs["low"]), np.asarray(attrs["high"]), cfg["normalize_actions"],
     )
-    model.pi.load_state_dict(groups["policy"])
-    model.v.load_state_dict(groups["value"])
-    norm = groups["obs_norm"]
-    model.norm.load_state_dict({"mean": torch.as_tensor(norm["mean"]), "std": torch.as_tensor(norm["std"])})
+    load_networks(groups, model)
     return model
+
+
+# ---------------------------------------------------------------------------- training glue
+def save_training(
+    path: Path,
+    cfg: PPOConfig,
+    model: ActorCritic,
+    pi_opt: torch.optim.Optimizer,
+    v_opt: torch.optim.Optimizer,
+    obs_stats: RunningObsStats,
+    rng: np.random.Generator,
+    iteration: int,
+    samples: int,
+    history: dict[str, list[float]],
+    env_attrs: dict[str, Any],
+    extra: dict[str, Any],
+    low: np.ndarray,
+    high: np.ndarray,
+    warm_start: Optional[str] = None,
+) -> Path:
+    """Write everything ``load_training`` needs to continue a run bit-identically.
+
+    Args:
+        path: the checkpoint file.
+        cfg: the run's config (stored as the ``config`` attribute).
+        model, pi_opt, v_opt, obs_stats, rng: the learner (networks, optimisers, normaliser
+            statistics, minibatch generator); the torch CPU RNG state is saved too.
+        iteration, samples: counters.
+        history: per-iteration stats.
+        env_attrs: attributes last set on every environment.
+        extra: caller state.
+        low, high: ``(act_dim,)`` action bounds.
+        warm_start: the checkpoint the run was warm-started from (provenance attribute).
+
+    Returns:
+        ``path``.
+    """
+    mean, std = model.norm.mean.numpy(), model.norm.std.numpy()
+    n_envs = cfg.n_workers * cfg.envs_per_worker
+    attrs: dict[str, Any] = {"config": cfg.to_dict(), "obs_dim": model.obs_dim, "act_dim": model.act_dim,
+                             "low": low, "high": high}
+    if warm_start is not None:
+        attrs["warm_start"] = str(warm_start)
+    return save(path, {
+        "policy": model.pi.state_dict(), "value": model.v.state_dict(),
+        "obs_norm": {"mean": mean, "std": std, **obs_stats.state()},
+        "policy_optim": pi_opt.state_dict(), "value_optim": v_opt.state_dict(),
+        "counters": {"iteration": iteration, "samples": samples},
+        "rng": {"numpy": json.dumps(rng.bit_generator.state), "torch": torch.get_rng_state(),
+                "seed": cfg.seed, "env_ids": np.arange(n_envs), "seed_offset": iteration},
+        "history": {k: np.asarray(v, dtype=np.float64) for k, v in history.items()},
+        "env_attrs": env_attrs, "extra": extra,
+    }, attrs)
+
+
+def load_training(
+    path: Path,
+    model: ActorCritic,
+    pi_opt: torch.optim.Optimizer,
+    v_opt: torch.optim.Optimizer,
+    obs_stats: RunningObsStats,
+    rng: np.random.Generator,
+) -> dict[str, Any]:
+    """Restore a ``save_training`` checkpoint into the learner, in place (and the torch CPU RNG).
+
+    Returns:
+        ``iteration``, ``samples``, ``history`` (``{name: [float]}``), ``env_attrs``, ``extra``
+        and ``warm_start`` (None unless the run was warm-started).
+    """
+    groups, attrs = load(path)
+    load_networks(groups, model, obs_stats)
+    pi_opt.load_state_dict(groups["policy_optim"])
+    v_opt.load_state_dict(groups["value_optim"])
+    rng.bit_generator.state = json.loads(groups["rng"]["numpy"])
+    torch.set_rng_state(groups["rng"]["torch"])
+    return {"iteration": groups["counters"]["iteration"], "samples": groups["counters"]["samples"],
+            "history": {k: [float(x) for x in v] for k, v in groups["history"].items()},
+            "env_attrs": groups["env_attrs"], "extra": groups["extra"],
+            "warm_start": attrs.get("warm_start")}
+
+
+def _jt_error(msg: str) -> Exception:
+    from toolkit.errors import JtError
+
+    return JtError(msg)
+
+
+def architecture_of(path: str | os.PathLike) -> dict[str, Any]:
+    """The network layout of a PPO checkpoint (what a warm start from it must match).
+
+    Returns:
+        ``policy_hidden`` and ``value_hidden`` (tuples of ints), ``normalize_actions`` (bool),
+        ``obs_dim`` and ``act_dim`` (ints).
+
+    Raises:
+        toolkit.errors.JtError: ``path`` is missing or not a jt PPO checkpoint.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise _jt_error(f"warm start {p}: no such checkpoint file")
+    try:
+        attrs = load_attrs(p)
+    except (OSError, ValueError) as e:
+        raise _jt_error(f"warm start {p}: not a jt PPO checkpoint ({e})") from None
+    c = attrs["config"]
+    return {"policy_hidden": tuple(int(v) for v in c["policy_hidden"]),
+            "value_hidden": tuple(int(v) for v in c["value_hidden"]),
+            "normalize_actions": bool(c["normalize_actions"]),
+            "obs_dim": int(attrs["obs_dim"]), "act_dim": int(attrs["act_dim"])}
+
+
+def with_architecture(cfg: PPOConfig, path: str | os.PathLike) -> PPOConfig:
+    """``cfg`` with the network sizes and action mapping of the checkpoint ``path`` (a copy).
+
+    Everything else (learning rates, schedules, budget, seed...) stays ``cfg``'s.
+    """
+    arch = architecture_of(path)
+    return dataclasses.replace(cfg, policy_hidden=arch["policy_hidden"], value_hidden=arch["value_hidden"],
+                               normalize_actions=arch["normalize_actions"])
+
+
+def load_warm_start(path: str | os.PathLike, cfg: PPOConfig, model: ActorCritic,
+                    obs_stats: RunningObsStats) -> None:
+    """Copy the policy, value network and observation normaliser (with its running statistics)
+    of the checkpoint ``path`` into a fresh learner; optimisers, counters and RNGs stay fresh.
+
+    Args:
+        path: a PPO checkpoint of the same layout (see ``with_architecture``).
+        cfg: the new run's config.
+        model: the new run's freshly built ``ActorCritic`` (its sizes are the environment's).
+        obs_stats: the new run's normaliser statistics.
+
+    Raises:
+        toolkit.errors.JtError: ``path`` is missing, not a checkpoint, or its observation/action
+            sizes or network layout differ from the environment's / ``cfg``'s.
+    """
+    arch = architecture_of(path)
+    if (arch["obs_dim"], arch["act_dim"]) != (model.obs_dim, model.act_dim):
+        raise _jt_error(f"warm start {path}: its policy has observation/action sizes "
+                        f"{arch['obs_dim']}/{arch['act_dim']}, this environment {model.obs_dim}/{model.act_dim}")
+    mine = (tuple(int(h) for h in cfg.policy_hidden), tuple(int(h) for h in cfg.value_hidden),
+            bool(cfg.normalize_actions))
+    theirs = (arch["policy_hidden"], arch["value_hidden"], arch["normalize_actions"])
+    if mine != theirs:
+        def show(a: tuple) -> str:
+            return f"policy_hidden={list(a[0])}, value_hidden={list(a[1])}, normalize_actions={str(a[2]).lower()}"
+
+        raise _jt_error(f"warm start {path} has {show(theirs)}; the config {show(mine)} "
+                        "(build it with toolkit.rl.with_architecture(cfg, path))")
+    groups, _ = load(path)
+    load_networks(groups, model, obs_stats)

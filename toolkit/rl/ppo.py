@@ -1,10 +1,11 @@
 """PPO as used by the athletic-jumping papers (000 §4.1, §6.2; 001 §3.4.1), in one readable file.
 
 Read top to bottom: the exploration-noise schedule, GAE(λ)/TD(λ), the clipped-surrogate
-update, and ``train`` (collect → estimate → update → checkpoint). Every hyper-parameter, with its
-source, is in ``PPOConfig`` (``toolkit/rl/config.py``, torch-free, re-exported here). Rollouts are
-collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either as executor actors or in this
-process; checkpoints are HDF5 files (``toolkit/rl/checkpoint.py``).
+update, and ``train`` (collect → estimate → update → checkpoint). Every
+hyper-parameter, with its source, is in ``PPOConfig`` (``toolkit/rl/config.py``, torch-free,
+re-exported here). Rollouts are collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either
+as executor actors or in this process; checkpoints (save, resume, warm start) are HDF5 files
+(``toolkit/rl/checkpoint.py``).
 
 Sources cited below: ``000`` = Yin et al. 2021 (the paper), ``001`` = Yang's thesis ch. 3 (the same
 work), ``code`` = the authors' public code (arpspoof/Jump, ``presets/default/...``), consulted where
@@ -14,7 +15,6 @@ the paper is silent. See ``docs/ppo.md`` for the deviations and the sanity bench
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 from pathlib import Path
@@ -25,11 +25,13 @@ import torch
 from torch import nn
 
 from toolkit.rl import checkpoint as ckpt
+from toolkit.rl.checkpoint import architecture_of, with_architecture
 from toolkit.rl.config import PPOConfig
 from toolkit.rl.networks import ActorCritic, RunningObsStats, gaussian_log_prob
 from toolkit.rl.rollout import merge_batches, start_workers
 
-__all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "compute_gae", "ppo_update", "train"]
+__all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "architecture_of", "compute_gae",
+           "ppo_update", "train", "with_architecture"]
 
 
 class IterationStats(dict):
@@ -211,9 +213,10 @@ def train(
     executor: Any = None,
     checkpoint_path: str | Path | None = None,
     resume: bool = True,
-    on_iteration: Optional[Callable[[int, int, dict[str, Any]], Optional[dict[str, Any]]]] = None,
+    on_iteration: Optional[Callable[[int, int, IterationStats], Optional[dict[str, Any]]]] = None,
     extra: Optional[dict[str, Any]] = None,
     should_stop: Optional[Callable[[], bool]] = None,
+    warm_start: str | Path | None = None,
 ) -> TrainResult:
     """Train a policy with PPO until ``cfg.total_samples`` samples have been collected.
 
@@ -228,21 +231,29 @@ def train(
         on_iteration: ``on_iteration(iteration, samples, stats)`` after each iteration (1-based
             count of iterations done, total samples). ``stats`` is an ``IterationStats``: a dict of
             floats (``mean_return``, ``mean_length``, ``n_episodes``, ``mean_reward``,
-            ``policy_loss``, ``value_loss``, ``clip_frac``, ``approx_kl``, ``explained_variance``,
-            ``action_std``, ``samples_per_s``, ``collect_s``, ``update_s``) whose ``.episodes``
-            lists the episodes finished in this iteration. It may return
-            a dict of attributes to set on every environment before the next iteration (e.g. a
+            ``policy_loss``, ``value_loss``, ``clip_frac``, ``approx_kl``, ``epochs_run``,
+            ``explained_variance``, ``action_std``, ``samples_per_s``, ``collect_s``, ``update_s``)
+            whose ``.episodes`` lists the episodes finished in this iteration. It may return a dict
+            of attributes to set on every environment before the next iteration (e.g. a
             curriculum's bar height); those are checkpointed and re-applied on resume.
         extra: caller state saved in every checkpoint's ``extra`` group and, on resume, replaced in
             place by the saved one (e.g. a curriculum's state).
         should_stop: checked after every iteration; training ends early (with a final checkpoint)
             when it returns True, e.g. once a curriculum reaches ``z_freeze``.
+        warm_start: a PPO checkpoint (e.g. a Stage-1 ``ppo.h5``) to start from when there is no
+            checkpoint to resume (``checkpoint_path`` absent or missing, or ``resume=False``): the
+            run is then a FRESH run (fresh optimisers, counters 0, the seeded RNGs of a fresh run,
+            empty history, the caller's ``extra``) whose policy, value network and observation
+            normaliser (with its running statistics) are ``warm_start``'s. Its network layout must
+            be ``cfg``'s (build ``cfg`` with ``with_architecture(cfg, warm_start)``). Ignored when
+            resuming: the checkpoint already holds the warm-started run.
 
     Returns:
         The trained model, counters, history and ``extra``.
 
     Raises:
-        toolkit.errors.JtError: a bad ``cfg`` value.
+        toolkit.errors.JtError: a bad ``cfg`` value, or a ``warm_start`` that is missing, not a
+            PPO checkpoint, or of other observation/action sizes or network layout.
     """
     cfg.check()
     extra = {} if extra is None else extra
@@ -258,24 +269,17 @@ def train(
     history: dict[str, list[float]] = {}
     env_attrs: dict[str, Any] = {}
     path = Path(checkpoint_path) if checkpoint_path is not None else None
+    started_from = str(warm_start) if warm_start is not None else None
 
     if path is not None and resume and path.exists():
-        groups, _ = ckpt.load(path)
-        model.pi.load_state_dict(groups["policy"])
-        model.v.load_state_dict(groups["value"])
-        norm = groups["obs_norm"]
-        model.norm.load_state_dict({"mean": torch.as_tensor(norm["mean"]),
-                                    "std": torch.as_tensor(norm["std"])})
-        obs_stats.load_state(norm)
-        pi_opt.load_state_dict(groups["policy_optim"])
-        v_opt.load_state_dict(groups["value_optim"])
-        iteration, samples = groups["counters"]["iteration"], groups["counters"]["samples"]
-        rng.bit_generator.state = json.loads(groups["rng"]["numpy"])
-        torch.set_rng_state(groups["rng"]["torch"])
-        history = {k: [float(x) for x in v] for k, v in groups["history"].items()}
-        env_attrs = groups["env_attrs"]
+        saved_run = ckpt.load_training(path, model, pi_opt, v_opt, obs_stats, rng)
+        iteration, samples = saved_run["iteration"], saved_run["samples"]
+        history, env_attrs = saved_run["history"], saved_run["env_attrs"]
         extra.clear()
-        extra.update(groups["extra"])
+        extra.update(saved_run["extra"])
+        started_from = saved_run["warm_start"]
+    elif warm_start is not None:  # a fresh run with another run's networks
+        ckpt.load_warm_start(warm_start, cfg, model, obs_stats)
 
     n_envs = cfg.n_workers * cfg.envs_per_worker
     n_steps = math.ceil(cfg.samples_per_iteration / n_envs)
@@ -285,18 +289,8 @@ def train(
 
     def save() -> Path:
         assert path is not None
-        mean, std = model.norm.mean.numpy(), model.norm.std.numpy()
-        return ckpt.save(path, {
-            "policy": model.pi.state_dict(), "value": model.v.state_dict(),
-            "obs_norm": {"mean": mean, "std": std, **obs_stats.state()},
-            "policy_optim": pi_opt.state_dict(), "value_optim": v_opt.state_dict(),
-            "counters": {"iteration": iteration, "samples": samples},
-            "rng": {"numpy": json.dumps(rng.bit_generator.state), "torch": torch.get_rng_state(),
-                    "seed": cfg.seed, "env_ids": np.arange(n_envs), "seed_offset": iteration},
-            "history": {k: np.asarray(v, dtype=np.float64) for k, v in history.items()},
-            "env_attrs": env_attrs, "extra": extra,
-        }, {"config": cfg.to_dict(), "obs_dim": obs_dim, "act_dim": act_dim,
-            "low": low, "high": high})
+        return ckpt.save_training(path, cfg, model, pi_opt, v_opt, obs_stats, rng, iteration, samples,
+                                  history, env_attrs, extra, low, high, started_from)
 
     saved: Optional[Path] = None
     try:
