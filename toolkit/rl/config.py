@@ -78,14 +78,21 @@ class PPOConfig:
     reward_scale: float = 1.0
     """Rewards are multiplied by this for learning only (reported returns stay raw); jt default 1."""
     reset_each_iteration: bool = True
-    """Start new seeded episodes at every iteration (cut episodes are bootstrapped like time
-    limits). Makes a resumed run bit-identical to an uninterrupted one; False lets episodes run on
-    across iterations (a resume then restarts episodes). jt choice, see docs/ppo.md."""
+    """True: every iteration starts new, seeded episodes in every environment (cut episodes are
+    bootstrapped like time limits). False: episodes run on across iterations (an episode may be
+    longer than one iteration's rollout; finished ones restart with the env's own RNG) and are
+    restarted with seeded resets only at the start of a run or resume and after every checkpoint
+    iteration (``iteration % checkpoint_every == 0``, whether or not a checkpoint file is
+    written). Either way a run resumed from a checkpoint written at such an iteration is
+    bit-identical to an uninterrupted one; with False, a resume from a checkpoint written at any
+    other iteration (the budget's end, ``should_stop``) restarts the episodes there. jt choice,
+    see docs/ppo.md."""
     total_samples: int = 100_000_000
     """Training budget in samples (not stated in 000; tasks set their own). 0 trains nothing (a
     warm start is then saved as it is)."""
     checkpoint_every: int = 100
-    """Iterations between checkpoints (code ``checkpoint_every_iteration: 100``); also at the end."""
+    """Iterations between checkpoints (code ``checkpoint_every_iteration: 100``); also at the end.
+    With ``reset_each_iteration=False`` also the episode-restart period."""
     seed: int = 0
     """Run seed: network init, minibatch order, every environment and action-noise seed."""
     n_workers: int = 1

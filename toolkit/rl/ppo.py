@@ -35,13 +35,27 @@ __all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "architec
 
 
 class IterationStats(dict):
-    """The scalar stats of one iteration (``{name: float}``), plus ``episodes``: one dict per
-    episode finished in it (``return``, ``length``, ``terminated`` and the numeric scalars of its
-    last ``info``), kept as an attribute so that ``items()`` yields only floats."""
+    """The scalar stats of one iteration (``{name: float}``), with per-episode lists kept as
+    attributes so that ``items()`` yields only floats.
 
-    def __init__(self, scalars: dict[str, float], episodes: list[dict[str, float]]) -> None:
+    Attributes:
+        episodes: one dict per episode FINISHED in this iteration's batch: ``return``, ``length``,
+            ``terminated`` and the numeric scalars of its last step's ``info``.
+        starts: one dict per episode STARTED in this iteration's batch (its first observation
+            ``s0`` is in the batch), ordered by step then environment: the numeric scalars of the
+            ``info`` that ``env.reset`` returned (e.g. a start phase the task tags it with), then
+            ``env`` (global environment index), ``step`` (row of the batch), ``value`` (V(s0) when
+            collected) and ``target`` (the TD(λ) target of s0 computed by GAE in this iteration,
+            in learning units, i.e. with ``reward_scale``). These four win over equally named
+            ``info`` keys. What importance sampling of start states needs (spacetime bounds eqs
+            11-12): a task can weight its start phases by ``target`` or ``target - value``.
+    """
+
+    def __init__(self, scalars: dict[str, float], episodes: list[dict[str, float]],
+                 starts: Optional[list[dict[str, float]]] = None) -> None:
         super().__init__(scalars)
         self.episodes = episodes
+        self.starts = [] if starts is None else starts
 
 
 @dataclasses.dataclass
@@ -233,9 +247,13 @@ def train(
             floats (``mean_return``, ``mean_length``, ``n_episodes``, ``mean_reward``,
             ``policy_loss``, ``value_loss``, ``clip_frac``, ``approx_kl``, ``epochs_run``,
             ``explained_variance``, ``action_std``, ``samples_per_s``, ``collect_s``, ``update_s``)
-            whose ``.episodes`` lists the episodes finished in this iteration. It may return a dict
-            of attributes to set on every environment before the next iteration (e.g. a
-            curriculum's bar height); those are checkpointed and re-applied on resume.
+            whose ``.episodes`` lists the episodes finished and ``.starts`` the episodes started
+            in this iteration.
+            It may return a dict of attributes to set (``env.set_wrapper_attr``) on every
+            environment of every worker before the next iteration: a curriculum's bar height, or
+            the reset-state distribution a task samples its episode starts from (e.g. start-phase
+            weights computed from ``stats.starts``). They act from the environments' next
+            ``reset``; they are checkpointed and re-applied on resume.
         extra: caller state saved in every checkpoint's ``extra`` group and, on resume, replaced in
             place by the saved one (e.g. a curriculum's state).
         should_stop: checked after every iteration; training ends early (with a final checkpoint)
@@ -293,16 +311,20 @@ def train(
                                   history, env_attrs, extra, low, high, started_from)
 
     saved: Optional[Path] = None
+    first = True
     try:
         if env_attrs:
             workers.call("set_env_attrs", [(env_attrs,)] * workers.size)
         while samples < cfg.total_samples:
-            # 1. collect: every worker steps its envs n_steps times with the current weights
+            # 1. collect: every worker steps its envs n_steps times with the current weights,
+            #    from new seeded episodes at run start and each checkpoint iteration (or always)
             t0 = time.perf_counter()
             std = action_std(samples, cfg)
+            restart = cfg.reset_each_iteration or first or iteration % cfg.checkpoint_every == 0
+            first = False
             weights = model.numpy_state()
             workers.call("set_weights", [(weights,)] * workers.size)
-            batch = merge_batches(workers.call("collect", [(n_steps, std, iteration)] * workers.size))
+            batch = merge_batches(workers.call("collect", [(n_steps, std, iteration, restart)] * workers.size))
             t1 = time.perf_counter()
             # 2. advantages GAE(λ) and value targets TD(λ)
             adv, targets = compute_gae(batch["rewards"] * cfg.reward_scale, batch["values"],
@@ -325,6 +347,9 @@ def train(
             samples += n_batch
             # 4. statistics, caller hook, checkpoint
             eps = batch["episodes"]
+            starts = sorted(({**s, "value": float(batch["values"][s["step"], s["env"]]),
+                              "target": float(targets[s["step"], s["env"]])} for s in batch["starts"]),
+                            key=lambda s: (s["step"], s["env"]))
             resid = flat["targets"] - batch["values"].reshape(-1)
             var_t = float(np.var(flat["targets"]))
             stats: dict[str, float] = {
@@ -342,7 +367,7 @@ def train(
             for k, v in stats.items():
                 history.setdefault(k, []).append(float(v))
             if on_iteration is not None:
-                attrs = on_iteration(iteration, samples, IterationStats(stats, eps))
+                attrs = on_iteration(iteration, samples, IterationStats(stats, eps, starts))
                 if attrs:
                     env_attrs.update(attrs)
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)

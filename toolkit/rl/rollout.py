@@ -10,10 +10,13 @@ Seeding, per environment ``k`` (global index ``worker * envs_per_worker + j``):
 - construction: ``env_fn(derive_seed(seed, 0, k))``;
 - action noise of a ``collect`` call: a fresh ``numpy`` PCG64 stream seeded by
   ``(seed, 1, k, seed_offset)`` (the trainer passes the iteration as ``seed_offset``);
-- resets: with ``reset_each_collect`` every ``collect`` call starts new episodes with
-  ``env.reset(seed=derive_seed(seed, 2, k, seed_offset))`` (a run resumed from a checkpoint is then
-  bit-identical to an uninterrupted one); otherwise episodes run on across calls and only the
-  first reset is seeded (later resets continue the environment's own RNG).
+- resets: a ``collect`` call that restarts (``reset=True``, or by default with
+  ``reset_each_collect``, and always the first call) starts new episodes with
+  ``env.reset(seed=derive_seed(seed, 2, k, seed_offset))``; otherwise episodes run on from the
+  previous call. Episodes that end inside a call restart with ``env.reset()`` (the environment's
+  own RNG, itself seeded by the last seeded reset). The trainer restarts at every iteration, or
+  with ``reset_each_iteration=False`` at run start and after each checkpoint iteration, which is
+  what makes a resumed run bit-identical to an uninterrupted one.
 """
 
 from __future__ import annotations
@@ -97,6 +100,8 @@ class RolloutWorker:
         self._obs: Optional[np.ndarray] = None  # (n_envs, obs_dim) current observations
         self._ep_ret = np.zeros(len(self.envs))
         self._ep_len = np.zeros(len(self.envs), dtype=np.int64)
+        # reset-info scalars of each env's current episode until its first observation is batched
+        self._pending_start: list[Optional[dict[str, float]]] = [None] * len(self.envs)
 
     def set_weights(self, state: dict[str, np.ndarray]) -> None:
         """Load the learner's ``ActorCritic.numpy_state()``."""
@@ -110,20 +115,23 @@ class RolloutWorker:
 
     def _reset_all(self, seed_offset: int) -> None:
         obs = []
-        for k, env in zip(self.env_ids, self.envs):
-            o, _ = env.reset(seed=derive_seed(self.seed, 2, k, seed_offset))
+        for j, (k, env) in enumerate(zip(self.env_ids, self.envs)):
+            o, info = env.reset(seed=derive_seed(self.seed, 2, k, seed_offset))
             obs.append(np.asarray(o, dtype=np.float32).reshape(-1))
+            self._pending_start[j] = _scalars(info)
         self._obs = np.stack(obs)
         self._ep_ret[:] = 0.0
         self._ep_len[:] = 0
 
-    def collect(self, n_steps: int, std: float, seed_offset: int) -> dict[str, Any]:
+    def collect(self, n_steps: int, std: float, seed_offset: int, reset: Optional[bool] = None) -> dict[str, Any]:
         """Run every environment ``n_steps`` control steps with actions ``N(mu(s), std^2)``.
 
         Args:
             n_steps: steps per environment.
             std: action standard deviation for this batch.
             seed_offset: mixes into every seed of this call (the trainer's iteration number).
+            reset: start new seeded episodes first (True) or continue the running ones (False);
+                None: as ``reset_each_collect``. The first call always starts new episodes.
 
         Returns:
             ``obs`` ``(n_steps, n_envs, obs_dim)`` float32, ``actions`` ``(n_steps, n_envs,
@@ -131,13 +139,16 @@ class RolloutWorker:
             ``(n_steps, n_envs)`` float32, ``rewards`` ``(n_steps, n_envs)`` float64,
             ``terminated`` and ``truncated`` ``(n_steps, n_envs)`` bool, and ``episodes``: one dict
             per episode finished in this call (``return``, ``length``, ``terminated`` and the
-            numeric scalars of the last step's ``info``). ``next_values[t]`` is the value of the
+            numeric scalars of the last step's ``info``), and ``starts``: one dict per episode whose
+            first observation is in this batch (the numeric scalars of the ``info`` its
+            ``env.reset`` returned, then ``env``: global env index, ``step``: its row ``t``).
+            ``next_values[t]`` is the value of the
             state reached by step ``t``: for a time-limit truncation the value of the final
             observation (bootstrapping), for the last step of the call the value of the state the
             next call continues from; it is meaningless (multiplied by 0) where ``terminated``.
         """
         n_envs = len(self.envs)
-        if self.reset_each_collect or self._obs is None:
+        if (self.reset_each_collect if reset is None else reset) or self._obs is None:
             self._reset_all(seed_offset)
         assert self._obs is not None
         rngs = [np.random.Generator(np.random.PCG64(
@@ -153,6 +164,7 @@ class RolloutWorker:
         trunc = np.zeros((n_steps, n_envs), bool)
         final_obs: list[tuple[int, int, np.ndarray]] = []  # (t, env, obs) at truncations
         episodes: list[dict[str, float]] = []
+        starts: list[dict[str, float]] = []
         with single_thread(), torch.no_grad():
             for t in range(n_steps):
                 obs_t = torch.from_numpy(self._obs)
@@ -160,6 +172,10 @@ class RolloutWorker:
                 eps = np.stack([r.standard_normal(act_dim) for r in rngs]).astype(np.float32)
                 act = mean + float(std) * torch.from_numpy(eps)
                 out_obs[t] = self._obs
+                for j, info0 in enumerate(self._pending_start):
+                    if info0 is not None:
+                        starts.append({**info0, "env": self.env_ids[j], "step": t})
+                        self._pending_start[j] = None
                 out_act[t] = act.numpy()
                 out_logp[t] = gaussian_log_prob(mean, float(std), act).numpy()
                 out_val[t] = value.numpy()
@@ -178,8 +194,9 @@ class RolloutWorker:
                         self._ep_ret[j], self._ep_len[j] = 0.0, 0
                         if trunc[t, j]:
                             final_obs.append((t, j, o))
-                        o, _ = env.reset()
+                        o, info0 = env.reset()
                         o = np.asarray(o, dtype=np.float32).reshape(-1)
+                        self._pending_start[j] = _scalars(info0)
                     next_obs[j] = o
                 self._obs = next_obs
             out_val[n_steps] = self.model.value(torch.from_numpy(self._obs)).numpy()
@@ -192,7 +209,7 @@ class RolloutWorker:
         return {
             "obs": out_obs, "actions": out_act, "logp": out_logp, "values": out_val[:-1].copy(),
             "next_values": out_next, "rewards": rewards, "terminated": term, "truncated": trunc,
-            "episodes": episodes,
+            "episodes": episodes, "starts": starts,
         }
 
     def close(self) -> None:
@@ -231,8 +248,7 @@ def start_workers(
 
 
 def merge_batches(parts: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Concatenate worker batches along the environment axis (axis 1); episodes in worker order."""
-    out: dict[str, Any] = {k: np.concatenate([p[k] for p in parts], axis=1)
-                           for k in parts[0] if k != "episodes"}
-    out["episodes"] = [e for p in parts for e in p["episodes"]]
-    return out
+    """Concatenate worker batches along the environment axis (axis 1, so column = global env
+    index); list entries (``episodes``, ``starts``) are joined in worker order."""
+    return {k: [e for p in parts for e in p[k]] if isinstance(parts[0][k], list)
+            else np.concatenate([p[k] for p in parts], axis=1) for k in parts[0]}

@@ -134,7 +134,8 @@ def test_curriculum_attrs_reach_the_envs():
 
 def test_episodes_span_iterations_without_reset():
     # 4 envs x 30 steps per iteration, 50-step episodes: only complete when they span iterations
-    cfg = dict(samples_per_iteration=120, total_samples=3 * 120)
+    # (without reset_each_iteration, episodes restart only at run start and checkpoint iterations)
+    cfg = dict(samples_per_iteration=120, total_samples=3 * 120, checkpoint_every=3)
     cut = train(ENV, tiny(**cfg)).history["n_episodes"]
     span = train(ENV, tiny(reset_each_iteration=False, **cfg)).history["n_episodes"]
     assert cut == [0.0, 0.0, 0.0]
