@@ -15,6 +15,7 @@ _EXPORTS = {
     "TrainResult": "toolkit.rl.ppo",
     "action_std": "toolkit.rl.ppo",
     "compute_gae": "toolkit.rl.ppo",
+    "learning_rates": "toolkit.rl.ppo",
     "train": "toolkit.rl.ppo",
     "architecture_of": "toolkit.rl.checkpoint",
     "with_architecture": "toolkit.rl.checkpoint",

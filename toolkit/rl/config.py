@@ -5,7 +5,8 @@ and check the ``agent`` group at composition time without loading the training s
 
 Sources cited below: ``000`` = Yin et al. 2021 (the athletic-jumping paper), ``001`` = Yang's
 thesis ch. 3 (the same work), ``code`` = the authors' public code (arpspoof/Jump,
-``presets/default/...``), consulted where the paper is silent. See ``docs/ppo.md`` for the deviations.
+``presets/default/...``), consulted where the paper is silent, ``getup`` = the get-up paper §5.6
+(step-wise std and learning-rate schedules). See ``docs/ppo.md`` for the deviations.
 """
 
 from __future__ import annotations
@@ -34,6 +35,11 @@ class PPOConfig:
     std_anneal_samples: float = 1.0e7
     """Samples over which σ decreases linearly, then stays at ``std_end`` (000 §4.1 "first 1.0×10^7
     simulation steps")."""
+    std_schedule: list[list[float]] = dataclasses.field(default_factory=list)
+    """Step-wise σ instead of the linear anneal: ``[[samples, std], ...]``, meaning "from this
+    sample count on, use this std" (piecewise constant; sample counts strictly increasing, the
+    first one 0). Empty (the default): the linear ``std_start`` → ``std_end`` anneal above. E.g.
+    getup §5.6, 0.6 → 0.3 every 20M steps: ``[[0, 0.6], [2e7, 0.5], [4e7, 0.4], [6e7, 0.3]]``."""
     samples_per_iteration: int = 4096
     """State-action samples collected per iteration (000 §6.2); rounded up to a whole number of
     steps per environment."""
@@ -51,6 +57,13 @@ class PPOConfig:
     """Policy learning rate (000 §6.2)."""
     value_lr: float = 1.0e-2
     """Value learning rate (000 §6.2)."""
+    lr_schedule: list[list[float]] = dataclasses.field(default_factory=list)
+    """Step-wise learning rates: ``[[samples, policy_lr, value_lr], ...]``, meaning "from this
+    sample count on, use these rates" (piecewise constant; sample counts strictly increasing, the
+    first one 0), written into both optimisers' ``param_groups`` at the start of every iteration
+    (and then also logged as ``policy_lr`` / ``value_lr``). Empty (the default): the constant
+    ``policy_lr`` and ``value_lr``. E.g. getup §5.6, 1e-4 → 2e-5 every 20M steps:
+    ``[[0, 1e-4, 1e-3], [2e7, 6e-5, 1e-3], [4e7, 2e-5, 1e-3]]``."""
     optimizer: str = "sgd"
     """``sgd`` (with momentum) or ``adam``; separate optimisers for policy and value. The paper does
     not name it; the authors' code uses SGD with momentum (code ``ppo.yaml``), as DeepMimic does."""
@@ -160,6 +173,48 @@ class PPOConfig:
             v = getattr(self, key)
             if not isinstance(v, bool):
                 raise bad(key, v, "must be true or false")
+        _check_schedule(self.std_schedule, 1, "[samples, std]", bad, "std_schedule")
+        _check_schedule(self.lr_schedule, 2, "[samples, policy_lr, value_lr]", bad, "lr_schedule")
+
+
+def scheduled(schedule: Sequence[Sequence[float]], samples: float) -> Optional[tuple[float, ...]]:
+    """The values of the piecewise-constant ``schedule`` in force at ``samples``.
+
+    Args:
+        schedule: ``[[samples_i, value_i...], ...]``, ``samples_i`` increasing.
+        samples: samples collected so far.
+
+    Returns:
+        ``value_i...`` of the last entry with ``samples_i <= samples`` (None if the schedule is
+        empty or starts later).
+    """
+    current: Optional[tuple[float, ...]] = None
+    for entry in schedule:
+        if float(entry[0]) > samples:
+            break
+        current = tuple(float(v) for v in entry[1:])
+    return current
+
+
+def _check_schedule(schedule: Any, n_values: int, form: str, bad: Any, key: str) -> None:
+    """Entries ``[samples, value...]``: samples whole, >= 0, strictly increasing, first 0; values > 0."""
+    if isinstance(schedule, (str, bytes)) or not isinstance(schedule, Sequence):
+        raise bad(key, schedule, f"must be a list of {form} entries (empty: off)")
+    previous = -1.0
+    for i, entry in enumerate(schedule):
+        where = f"{key}[{i}]"
+        if isinstance(entry, (str, bytes)) or not isinstance(entry, Sequence) or len(entry) != 1 + n_values:
+            raise bad(where, entry, f"must be {form}")
+        at, *values = entry
+        if not (_is_whole(at) and at >= 0):
+            raise bad(where, entry, "the sample count must be a whole number >= 0")
+        if i == 0 and at != 0:
+            raise bad(where, entry, "the first entry must start at 0 samples")
+        if at <= previous:
+            raise bad(where, entry, "sample counts must increase strictly")
+        if not all(_is_real(v) and math.isfinite(v) and v > 0 for v in values):
+            raise bad(where, entry, "values must be finite numbers > 0")
+        previous = float(at)
 
 
 def _is_int(v: Any) -> bool:

@@ -1,7 +1,7 @@
 """PPO as used by the athletic-jumping papers (000 §4.1, §6.2; 001 §3.4.1), in one readable file.
 
-Read top to bottom: the exploration-noise schedule, GAE(λ)/TD(λ), the clipped-surrogate
-update, and ``train`` (collect → estimate → update → checkpoint). Every
+Read top to bottom: the exploration-noise and learning-rate schedules, GAE(λ)/TD(λ), the
+clipped-surrogate update, and ``train`` (collect → estimate → update → checkpoint). Every
 hyper-parameter, with its source, is in ``PPOConfig`` (``toolkit/rl/config.py``, torch-free,
 re-exported here). Rollouts are collected by ``RolloutWorker``s (``toolkit/rl/rollout.py``), either
 as executor actors or in this process; checkpoints (save, resume, warm start) are HDF5 files
@@ -26,12 +26,12 @@ from torch import nn
 
 from toolkit.rl import checkpoint as ckpt
 from toolkit.rl.checkpoint import architecture_of, with_architecture
-from toolkit.rl.config import PPOConfig
+from toolkit.rl.config import PPOConfig, scheduled
 from toolkit.rl.networks import ActorCritic, RunningObsStats, gaussian_log_prob
 from toolkit.rl.rollout import merge_batches, start_workers
 
 __all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "architecture_of", "compute_gae",
-           "ppo_update", "train", "with_architecture"]
+           "learning_rates", "ppo_update", "train", "with_architecture"]
 
 
 class IterationStats(dict):
@@ -80,11 +80,22 @@ class TrainResult:
 
 
 def action_std(samples: float, cfg: PPOConfig) -> float:
-    """σ after ``samples`` samples: linear from ``std_start`` to ``std_end`` (000 §4.1)."""
+    """σ after ``samples`` samples: linear from ``std_start`` to ``std_end`` (000 §4.1), or the
+    step-wise ``std_schedule`` when one is given."""
+    if cfg.std_schedule:
+        step = scheduled(cfg.std_schedule, samples)
+        return float(cfg.std_start if step is None else step[0])
     if cfg.std_anneal_samples <= 0:
         return float(cfg.std_end)
     frac = min(max(samples / cfg.std_anneal_samples, 0.0), 1.0)
     return float(cfg.std_start + frac * (cfg.std_end - cfg.std_start))
+
+
+def learning_rates(samples: float, cfg: PPOConfig) -> tuple[float, float]:
+    """``(policy_lr, value_lr)`` after ``samples`` samples: ``cfg``'s constants, or the step-wise
+    ``lr_schedule`` when one is given."""
+    step = scheduled(cfg.lr_schedule, samples) if cfg.lr_schedule else None
+    return (float(cfg.policy_lr), float(cfg.value_lr)) if step is None else (step[0], step[1])
 
 
 def compute_gae(
@@ -246,9 +257,9 @@ def train(
             count of iterations done, total samples). ``stats`` is an ``IterationStats``: a dict of
             floats (``mean_return``, ``mean_length``, ``n_episodes``, ``mean_reward``,
             ``policy_loss``, ``value_loss``, ``clip_frac``, ``approx_kl``, ``epochs_run``,
-            ``explained_variance``, ``action_std``, ``samples_per_s``, ``collect_s``, ``update_s``)
-            whose ``.episodes`` lists the episodes finished and ``.starts`` the episodes started
-            in this iteration.
+            ``explained_variance``, ``action_std``, [``policy_lr``, ``value_lr`` with an
+            ``lr_schedule``], ``samples_per_s``, ``collect_s``, ``update_s``) whose ``.episodes``
+            lists the episodes finished and ``.starts`` the episodes started in this iteration.
             It may return a dict of attributes to set (``env.set_wrapper_attr``) on every
             environment of every worker before the next iteration: a curriculum's bar height, or
             the reset-state distribution a task samples its episode starts from (e.g. start-phase
@@ -320,6 +331,11 @@ def train(
             #    from new seeded episodes at run start and each checkpoint iteration (or always)
             t0 = time.perf_counter()
             std = action_std(samples, cfg)
+            if cfg.lr_schedule:  # step-wise rates, written into the optimisers (resumes alike)
+                lrs = learning_rates(samples, cfg)
+                for opt, lr in zip((pi_opt, v_opt), lrs):
+                    for group in opt.param_groups:
+                        group["lr"] = lr
             restart = cfg.reset_each_iteration or first or iteration % cfg.checkpoint_every == 0
             first = False
             weights = model.numpy_state()
@@ -360,6 +376,7 @@ def train(
                 **losses,
                 "explained_variance": 1.0 - float(np.var(resid)) / var_t if var_t > 0 else float("nan"),
                 "action_std": std,
+                **({"policy_lr": lrs[0], "value_lr": lrs[1]} if cfg.lr_schedule else {}),
                 "samples_per_s": n_batch / (t2 - t0),
                 "collect_s": t1 - t0,
                 "update_s": t2 - t1,

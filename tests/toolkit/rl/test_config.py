@@ -11,7 +11,7 @@ import pytest
 
 from toolkit.errors import JtError
 from toolkit.rl import config as config_module
-from toolkit.rl.config import PPOConfig
+from toolkit.rl.config import PPOConfig, scheduled
 
 
 def test_config_module_imports_no_torch_or_numpy():
@@ -44,7 +44,8 @@ def test_defaults_and_edge_values_pass():
     PPOConfig().check()
     PPOConfig(total_samples=0, std_anneal_samples=0, max_grad_norm=0.0, adv_clip=0.0, gamma=0.0, lam=1.0,
               target_kl=0.02, optimizer="adam").check()
-    PPOConfig(total_samples=1e8, samples_per_iteration=4096.0, max_grad_norm=math.inf).check()
+    PPOConfig(total_samples=1e8, samples_per_iteration=4096.0, max_grad_norm=math.inf,
+              std_schedule=[[0, 0.6], [2e7, 0.5]], lr_schedule=[(0, 1e-4, 1e-3), (2e7, 2e-5, 1e-3)]).check()
 
 
 @pytest.mark.parametrize("changes, message", [
@@ -71,6 +72,12 @@ def test_defaults_and_edge_values_pass():
     ({"optimizer": "rmsprop"}, "agent.optimizer=rmsprop: must be one of sgd, adam"),
     ({"policy_hidden": (64, 0)}, "agent.policy_hidden=[64, 0]: must be a list of layer sizes (integers >= 1)"),
     ({"reset_each_iteration": "no"}, "agent.reset_each_iteration=no: must be true or false"),
+    ({"std_schedule": [[0, 0.6], [10, 0.0]]}, "agent.std_schedule[1]=[10, 0.0]: values must be finite numbers > 0"),
+    ({"std_schedule": [[5, 0.6]]}, "agent.std_schedule[0]=[5, 0.6]: the first entry must start at 0 samples"),
+    ({"std_schedule": [[0, 0.6], [0, 0.3]]}, "agent.std_schedule[1]=[0, 0.3]: sample counts must increase strictly"),
+    ({"lr_schedule": [[0, 1e-4]]}, "agent.lr_schedule[0]=[0, 0.0001]: must be [samples, policy_lr, value_lr]"),
+    ({"lr_schedule": 0.1},
+     "agent.lr_schedule=0.1: must be a list of [samples, policy_lr, value_lr] entries (empty: off)"),
 ])
 def test_check_names_key_value_and_range(changes, message):
     with pytest.raises(JtError) as e:
@@ -87,3 +94,10 @@ def test_check_prefix_and_train_refuses_a_bad_config():
     with pytest.raises(JtError, match=r"^agent\.minibatch_size=0: "):
         train(GymEnvFn("Pendulum-v1"), PPOConfig(minibatch_size=0))
 
+
+def test_scheduled_is_piecewise_constant():
+    sched = [[0, 0.6], [100, 0.5], [200, 0.3]]
+    assert scheduled(sched, 0) == (0.6,) and scheduled(sched, 99.9) == (0.6,)
+    assert scheduled(sched, 100) == (0.5,) and scheduled(sched, 10**9) == (0.3,)
+    assert scheduled([], 5) is None and scheduled([[10, 1.0]], 5) is None
+    assert scheduled([[0, 1e-4, 1e-3], [50, 2e-5, 5e-4]], 60) == (2e-5, 5e-4)
