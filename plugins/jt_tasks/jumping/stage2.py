@@ -24,11 +24,12 @@ the same evaluation (found through their logged params ``task.stage``, ``task.in
 ``task.init_eval``) + ``task.policy_features``. Running the command again therefore adds one policy
 per run, as the paper's "five DRL iterations from each good initial state" (``000`` §7.1.1).
 
-Warm start (``write_warm_start``): the Stage-2 ``ppo.h5`` starts as a copy of the Stage-1 policy,
-value network and observation normaliser (with its running statistics), with a FRESH optimiser,
-counters at 0 and the seeded RNGs of a fresh run; the network sizes are taken from the Stage-1
-checkpoint. PPO then "resumes" from it, so a killed Stage-2 evaluation also resumes. The
-curriculum starts afresh (the paper does not say; ours).
+Warm start (``Stage2Init.checkpoint``, trained with ``toolkit.rl.ppo.train(..., warm_start=)`` on
+a config built by ``toolkit.rl.with_architecture``): the Stage-2 run is a fresh PPO run (FRESH
+optimisers, counters at 0, the seeded RNGs of a fresh run) whose policy, value network and
+observation normaliser (with its running statistics) and network sizes are the Stage-1
+checkpoint's; a killed Stage-2 evaluation resumes from its own ``ppo.h5``. The curriculum starts
+afresh (the paper does not say; ours).
 """
 
 from __future__ import annotations
@@ -187,66 +188,6 @@ def check_reward(terms: dict) -> None:
     if "novelty" not in (terms or {}):
         raise _err("task.stage=2: the reward has no 'novelty' term (000 eq 15); use reward=highjump_stage2 "
                    "or leave the reward group unset")
-
-
-# ---------------------------------------------------------------------------- warm start
-def adopt_architecture(cfg: Any, init_ckpt: Path) -> Any:
-    """``cfg`` (a ``PPOConfig``) with the Stage-1 checkpoint's network sizes and action mapping."""
-    from toolkit.rl import checkpoint as ck
-
-    _, attrs = ck.load(init_ckpt)
-    c = attrs["config"]
-    new = dataclasses.replace(cfg, policy_hidden=tuple(int(v) for v in c["policy_hidden"]),
-                              value_hidden=tuple(int(v) for v in c["value_hidden"]),
-                              normalize_actions=bool(c["normalize_actions"]))
-    if (new.policy_hidden, new.value_hidden) != (tuple(cfg.policy_hidden), tuple(cfg.value_hidden)):
-        print(f"jt: stage 2: networks {list(new.policy_hidden)}/{list(new.value_hidden)} from the init policy",
-              file=sys.stderr, flush=True)
-    return new
-
-
-def write_warm_start(path: Path, init_ckpt: Path, cfg: Any, env_fn: Any, extra: dict) -> Path:
-    """Write ``path``: a PPO checkpoint that ``toolkit.rl.ppo.train`` resumes as a fresh run whose
-    policy, value network and observation normaliser are those of ``init_ckpt``.
-
-    Args:
-        path: the Stage-2 ``ppo.h5``.
-        init_ckpt: the Stage-1 ``ppo.h5``.
-        cfg: the Stage-2 ``PPOConfig`` (after ``adopt_architecture``).
-        env_fn: ``env_fn(seed)`` of the Stage-2 environments (probed for the dimensions).
-        extra: the trainer's ``extra`` (curriculum state) to start with.
-    """
-    import json
-
-    import numpy as np
-    import torch
-
-    from toolkit.rl import checkpoint as ck
-    from toolkit.rl import ppo
-    from toolkit.rl.networks import ActorCritic
-
-    groups, attrs = ck.load(init_ckpt)
-    obs_dim, act_dim, low, high = ppo._probe(env_fn, cfg.seed)
-    if (obs_dim, act_dim) != (int(attrs["obs_dim"]), int(attrs["act_dim"])):
-        raise _err(f"task.init: the Stage-1 policy has obs/action sizes {attrs['obs_dim']}/{attrs['act_dim']}, "
-                   f"this Stage-2 set-up {obs_dim}/{act_dim}; use Stage 1's action and character settings")
-    torch.manual_seed(cfg.seed)  # the RNG state a fresh run has after building its networks
-    model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions)
-    model.pi.load_state_dict(groups["policy"])
-    model.v.load_state_dict(groups["value"])
-    pi_opt = ppo._make_optimizer(model.pi.parameters(), cfg.policy_lr, cfg)
-    v_opt = ppo._make_optimizer(model.v.parameters(), cfg.value_lr, cfg)
-    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([cfg.seed, 3])))
-    n_envs = cfg.n_workers * cfg.envs_per_worker
-    return ck.save(path, {
-        "policy": groups["policy"], "value": groups["value"], "obs_norm": groups["obs_norm"],
-        "policy_optim": pi_opt.state_dict(), "value_optim": v_opt.state_dict(),
-        "counters": {"iteration": 0, "samples": 0},
-        "rng": {"numpy": json.dumps(rng.bit_generator.state), "torch": torch.get_rng_state(),
-                "seed": cfg.seed, "env_ids": np.arange(n_envs), "seed_offset": 0},
-        "history": {}, "env_attrs": {}, "extra": dict(extra),
-    }, {"config": cfg.to_dict(), "obs_dim": obs_dim, "act_dim": act_dim, "low": low, "high": high,
-        "warm_start": str(init_ckpt)})
 
 
 # ---------------------------------------------------------------------------- metrics
