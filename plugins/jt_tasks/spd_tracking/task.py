@@ -110,21 +110,20 @@ class SPDTrackingTask(Task):
         return {"sim": sim, "character": character, "spd": spd}
 
     def reference(self, run_cfg: dict) -> tuple[Any, dict]:
-        """The reference motion and model facts (``dof``, ``depth``, ``n_q``, end-effector)."""
-        import pybullet as pb
-
+        """The reference motion and model facts (``dof``, ``depth``, ``n_q``, end-effector), read
+        from a simulator instance of the run's config (the registry's ``sim``)."""
         from jt_tasks.spd_tracking.motions import make_reference
         from jt_tasks.spd_tracking.tracking import end_effector, simulator_class
 
-        c = pb.connect(pb.DIRECT)
+        sim = simulator_class(run_cfg)(run_cfg)
         try:
-            ch = simulator_class(run_cfg).load_character(run_cfg["character"], c)
+            ch = sim.character
             ref = make_reference(ch, self.params.motion, self.params.wave)
-            model = ch.model()
+            model = sim.model
             facts = {"character": ch.name, "dof": model.n_v, "depth": model.depth,
-                     "n_q": model.n_q, "end_effector": end_effector(ch)[0]}
+                     "n_q": model.n_q, "end_effector": end_effector(sim)[0]}
         finally:
-            pb.disconnect(c)
+            sim.close()
         return ref, facts
 
     # ------------------------------------------------------------------ evaluation

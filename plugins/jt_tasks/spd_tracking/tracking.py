@@ -8,8 +8,10 @@ eq 2.4). The error after each step is (thesis §2.4.1)
 
 with ``p_root`` the base position and ``p_ee`` the end-effector (humanoid: right ankle joint;
 laikago: right front toe; snake: the tail tip). The reference vectors come from a kinematic
-copy of the character in a second PyBullet client. A NaN or exploding state, or an error above
-``diverge_error``, stops the run as diverged; the remaining errors are NaN.
+copy of the character in a second simulator instance (reset to each reference pose, read by
+``link_pose``). The simulator is the configured plugin, found through the registry. A NaN or
+exploding state, or an error above ``diverge_error``, stops the run as diverged; the remaining
+errors are NaN.
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from toolkit.interfaces.simulator import BASE
+
 END_EFFECTORS = {  # character: (link name, offset in the link frame)     001 §2.4.1 (ours: snake)
     "humanoid": ("right_ankle", (0.0, 0.0, 0.0)),
     "laikago": ("toeFR", (0.0, 0.0, 0.0)),
@@ -28,12 +32,14 @@ END_EFFECTORS = {  # character: (link name, offset in the link frame)     001 §
 }
 
 
-def end_effector(character: Any) -> tuple[str, tuple[float, float, float]]:
-    """``(link name, offset)`` of the tracked end-effector of a ``Character``."""
-    name = character.name
+def end_effector(sim: Any) -> tuple[str, tuple[float, float, float]]:
+    """``(link name, offset in the link frame)`` of the tracked end-effector of a simulator's
+    character (its ``character``: ``name``, ``joint_indices``), read before any step."""
+    ch = sim.character
+    name = ch.name
     if name.startswith("snake"):
-        k = len(character.joint_indices)
-        return f"seg{k}", (0.5 * _segment_length(character), 0.0, 0.0)  # tail tip
+        k = len(ch.joint_indices)
+        return f"seg{k}", (0.5 * _segment_length(sim), 0.0, 0.0)  # tail tip
     return END_EFFECTORS[name]
 
 
@@ -71,13 +77,14 @@ class TrackResult:
         return self.spd_median_s / self.substep_median_s
 
 
-def _ee_vector(pb: Any, client: int, body: int, link: int, offset: np.ndarray) -> np.ndarray:
-    s = pb.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
-    p = np.array(s[4])
+def _ee_vector(sim: Any, link: int, offset: np.ndarray) -> np.ndarray:
+    """``p_ee - p_root`` ``(3,)`` now: the link frame's origin (plus ``offset`` ``(3,)`` in that
+    frame) minus the base position, world frame."""
+    p, q = sim.link_pose(link)
     if offset.any():
-        p = p + _rotate(s[5], offset)
-    base, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    return p - np.array(base)
+        p = p + _rotate(q, offset)
+    base, _ = sim.link_pose(BASE)
+    return p - base
 
 
 def _rotate(q: Any, v: np.ndarray) -> np.ndarray:
@@ -86,25 +93,12 @@ def _rotate(q: Any, v: np.ndarray) -> np.ndarray:
     return quat_rotate(np.array(q), v)
 
 
-def _segment_length(character: Any) -> float:
-    """Length of a snake segment: the distance between its last two joint origins at rest."""
-    import pybullet as pb
-
-    a, b = character.joint_indices[-2:]
-    pa = pb.getLinkState(character.body_id, a, physicsClientId=character.client)[4]
-    pb_ = pb.getLinkState(character.body_id, b, physicsClientId=character.client)[4]
-    return float(np.linalg.norm(np.subtract(pb_, pa)))
-
-
-def find_link(client: int, body: int, name: str) -> int:
-    """PyBullet index of the link (or the joint whose child link) called ``name``."""
-    import pybullet as pb
-
-    infos = [pb.getJointInfo(body, j, physicsClientId=client) for j in range(pb.getNumJoints(body, physicsClientId=client))]
-    for j, info in enumerate(infos):
-        if name in (info[12].decode(), info[1].decode()):
-            return j
-    raise KeyError(f"no link or joint {name!r}; links: {', '.join(i[12].decode() for i in infos)}")
+def _segment_length(sim: Any) -> float:
+    """Length of a snake segment: the distance between its last two joint origins, as loaded."""
+    a, b = sim.character.joint_indices[-2:]
+    pa, _ = sim.link_pose(a)
+    p_b, _ = sim.link_pose(b)
+    return float(np.linalg.norm(np.subtract(p_b, pa)))
 
 
 def simulator_class(run_cfg: Any) -> Any:
@@ -115,25 +109,20 @@ def simulator_class(run_cfg: Any) -> Any:
 
 
 def reference_vectors(run_cfg: Any, ref: Any, times: np.ndarray) -> np.ndarray:
-    """``(p_ee - p_root)`` of the reference at ``times`` ``(n,)`` → ``(n, 3)``, by PyBullet FK."""
-    import pybullet as pb
-
-    from toolkit.dynamics.bullet_io import BulletBody
-
-    c = pb.connect(pb.DIRECT)
+    """``(p_ee - p_root)`` of the reference at ``times`` ``(n,)`` → ``(n, 3)``: a simulator of its
+    own reset to each pose (zero velocity, no step) and read by forward kinematics."""
+    sim = simulator_class(run_cfg)(run_cfg)
     try:
-        ch = simulator_class(run_cfg).load_character(run_cfg["character"], c)
-        io = BulletBody(c, ch.body_id, ch.model())
-        link_name, off = end_effector(ch)
-        link = find_link(c, ch.body_id, link_name)
-        zero = np.zeros(ch.n_dof)
+        link_name, off = end_effector(sim)
+        link = sim.link_index(link_name)
+        zero = np.zeros(sim.model.n_v)
         out = np.empty((len(times), 3))
         for i, q in enumerate(ref.poses(np.asarray(times, dtype=float))):
-            io.reset(q, zero)
-            out[i] = _ee_vector(pb, c, ch.body_id, link, np.asarray(off, float))
+            sim.reset(q, zero)
+            out[i] = _ee_vector(sim, link, np.asarray(off, float))
         return out
     finally:
-        pb.disconnect(c)
+        sim.close()
 
 
 def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_velocity: bool = True,
@@ -152,8 +141,6 @@ def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_veloc
         render_every: capture a frame every this many simulated seconds (None: no frames).
         render_size: ``(width, height)`` of captured frames.
     """
-    import pybullet as pb
-
     cfg = {**run_cfg, "sim": {**run_cfg.get("sim", {}), "sim_hz": float(rate_hz),
                               "control_hz": float(rate_hz)}}
     n = max(1, int(round(duration * rate_hz)))
@@ -163,8 +150,8 @@ def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_veloc
     vels = ref.velocities(times) if target_velocity else [None] * n
     sim = simulator_class(cfg)(cfg)
     try:
-        link_name, off = end_effector(sim.character)
-        link = find_link(sim.client, sim.character.body_id, link_name)
+        link_name, off = end_effector(sim)
+        link = sim.link_index(link_name)
         off = np.asarray(off, float)
         q0, v0 = ref.pose(0.0), ref.velocity(0.0)
         sim.reset(q0, v0)
@@ -186,7 +173,7 @@ def track(run_cfg: dict, ref: Any, rate_hz: float, duration: float, target_veloc
             if rec["failed"]:
                 diverged, reason = True, rec["reason"]
                 break
-            v = _ee_vector(pb, sim.client, sim.character.body_id, link, off)
+            v = _ee_vector(sim, link, off)
             ee_sim[k] = v
             e = float(np.linalg.norm(v - ee_ref[k]))
             err[k] = e

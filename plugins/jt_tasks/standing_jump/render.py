@@ -1,4 +1,4 @@
-"""Pictures: filmstrips of jumps (PyBullet TinyRenderer, side view) and the Pareto-front plot.
+"""Pictures: filmstrips of jumps (the planar world's renderer, side view) and the Pareto-front plot.
 
 The filmstrip re-simulates a parameter vector, keeps the pose at the start of each phase and at
 the apex (as ``004`` Fig. 9 does: "capturing the pose at the beginning of each phase"), renders
@@ -20,36 +20,37 @@ BLUE = (0.2, 0.4, 0.85, 1.0)
 
 
 def render_poses(qs: Sequence[Sequence[float]], rgba=BROWN, width: int = 160, height: int = 240,
-                 mass: float = 80.0, body_height: float = 1.60) -> list[np.ndarray]:
+                 mass: float = 80.0, body_height: float = 1.60, sim: str = "bullet") -> list[np.ndarray]:
     """Render joint-position vectors ``(19,)`` of the character, side view, one image each.
+
+    Args:
+        qs: joint positions, one ``(19,)`` vector per image (world joint order).
+        rgba: the character's colour.
+        width: image width, px.
+        height: image height, px.
+        mass: character mass, kg.
+        body_height: character height, m.
+        sim: registry name of the simulator plugin with the planar world (``bullet``).
 
     Returns:
         RGB images ``(height, width, 3)`` uint8.
     """
-    import pybullet as p
-
     from jt_tasks.standing_jump.model import build_body
-    from jt_tasks.standing_jump.simulate import open_world
+    from jt_tasks.standing_jump.simulate import planar_world
 
     body = build_body(mass, body_height)
-    cid, robot, _, names = open_world(body, 1.0, 1000.0, rgba)
+    world = planar_world(body, 1.0, 1000.0, rgba, sim)
     try:
-        proj = p.computeProjectionMatrixFOV(fov=45.0, aspect=width / height, nearVal=0.1, farVal=20.0,
-                                            physicsClientId=cid)
+        names = world.joint_names
         images = []
         for q in qs:
-            for i, v in enumerate(q):
-                p.resetJointState(robot, i, v, physicsClientId=cid)
+            world.reset_joints(q)
             x = q[names.index("root_x")]
             z = max(1.0, q[names.index("root_z")] + 0.25)
-            eye, target = [x, -4.2, z], [x, 0.0, z]
-            view = p.computeViewMatrix(eye, target, [0, 0, 1], physicsClientId=cid)
-            img = p.getCameraImage(width, height, view, proj, renderer=p.ER_TINY_RENDERER,
-                                   lightDirection=[-1, -2, 3], shadow=0, physicsClientId=cid)[2]
-            images.append(np.asarray(img, dtype=np.uint8).reshape(height, width, 4)[:, :, :3])
+            images.append(world.render(width, height, eye=[x, -4.2, z], target=[x, 0.0, z]))
         return images
     finally:
-        p.disconnect(cid)
+        world.close()
 
 
 def filmstrip(point: dict[str, float], path: Path, title: str, settings=None, width: int = 160,
@@ -64,7 +65,8 @@ def filmstrip(point: dict[str, float], path: Path, title: str, settings=None, wi
 
     res = simulate(point, settings, record=True)
     rgba = BROWN if res.natural else BLUE
-    kw = {} if settings is None else {"mass": settings.mass, "body_height": settings.height}
+    kw = {} if settings is None else {"mass": settings.mass, "body_height": settings.height,
+                                      "sim": settings.sim}
     images = render_poses([q for _, q in res.snapshots], rgba, width, height, **kw)
     k = max(len(images), 1)
     fig, axes = plt.subplots(1, k, figsize=(1.3 * k * width / 160, 2.3 * height / 240), squeeze=False)

@@ -1,13 +1,15 @@
-"""One standing jump in PyBullet: build the world, run the controller, measure the result.
+"""One standing jump: build the world, run the controller, measure the result.
 
-PyBullet runs in its own DIRECT client per call (nothing shared between evaluations, so the same
-parameters give the same result). The default joint motors are disabled and the controller's
-torques are applied with ``TORQUE_CONTROL`` at every simulation step (``sim_hz``, 600 Hz by
-default). The PD targets become torques by Stable PD, solved by one of jt's SPD backends
-(``spd=maba|df|sf|pcg``, loaded through the plugin registry) on ``Model.from_bullet`` of the
-body. The supernatural assist of ``004`` §3.3 is reduced gravity after take-off, ramping back
-to -9.8 m/s² over the assist duration; it is applied with ``setGravity`` only while it differs
-from normal gravity, so a natural controller runs with exactly zero external force.
+The world is the simulator plugin's planar world (``sim=bullet``: ``jt_bullet.planar``), found
+through the registry: the planar URDF of ``model.write_urdf`` on a ground plane in a world of its
+own per call (nothing shared between evaluations, so the same parameters give the same result),
+the default joint motors off, the controller's torques applied at every simulation step
+(``sim_hz``, 600 Hz by default). The PD targets become torques by Stable PD, solved by one of
+jt's SPD backends (``spd=maba|df|sf|pcg``, loaded through the plugin registry) on the world's
+``toolkit.dynamics`` model of the body. The supernatural assist of ``004`` §3.3 is reduced
+gravity after take-off, ramping back to -9.8 m/s² over the assist duration; it is set on the world
+only while it differs from normal gravity, so a natural controller runs with exactly zero external
+force.
 """
 
 from __future__ import annotations
@@ -21,6 +23,12 @@ from jt_tasks.standing_jump.controller import JumpController
 from jt_tasks.standing_jump.kinematics import PlanarKinematics
 from jt_tasks.standing_jump.timing import Timing
 from jt_tasks.standing_jump.model import Body, build_body, effort_weights, standing_head_height, write_urdf
+from toolkit.errors import JtError
+
+
+class UnusableSPD(JtError, ValueError):
+    """The ``spd`` group names a backend standing_jump cannot use (a one-line ``JtError``; also the
+    ``ValueError`` callers caught before)."""
 
 
 @dataclasses.dataclass
@@ -43,6 +51,7 @@ class SimSettings:
         spd: the run's ``spd`` group as a plain dict (``{"name": "maba"}``: registry name of the
             SPD backend and its parameters); any of maba, df, sf, pcg (``bullet`` cannot serve:
             it never returns torques, and the controller adds torques after the solve).
+        sim: registry name of the simulator plugin whose planar world runs the jump (``bullet``).
     """
 
     sim_hz: float = 600.0
@@ -57,6 +66,7 @@ class SimSettings:
     assist_deadzone: float = 0.05
     stable_pd: bool = True
     spd: dict = dataclasses.field(default_factory=lambda: {"name": "maba"})
+    sim: str = "bullet"
 
 
 @dataclasses.dataclass
@@ -107,33 +117,46 @@ class JumpResult:
         return self.e_se == 0.0
 
 
-def open_world(body: Body, friction: float, sim_hz: float,
-               rgba: tuple = (0.55, 0.36, 0.2, 1.0)) -> tuple[int, int, int, list[str]]:
-    """A DIRECT PyBullet client with a ground plane and the character standing at x = 0.
+def planar_world(body: Body, friction: float, sim_hz: float,
+                 rgba: tuple = (0.55, 0.36, 0.2, 1.0), sim: str = "bullet") -> Any:
+    """The simulator plugin's planar world with the character standing at x = 0.
+
+    Args:
+        body: the character (its URDF is written by ``write_urdf``, cached).
+        friction: ground and foot Coulomb friction coefficient.
+        sim_hz: simulation rate, Hz.
+        rgba: the character's colour.
+        sim: registry name of the simulator plugin (``jt.simulators``) that has a planar world.
 
     Returns:
-        ``(client id, robot id, ground id, joint names)``; the caller disconnects.
-    """
-    import pybullet as p
+        A planar world (``jt_bullet.planar.PlanarWorld`` for ``sim=bullet``): ``joint_names``,
+        ``link_names``, ``joint_states()``, ``apply_torques``, ``step``, ``render`` ...; the
+        caller closes it.
 
-    cid = p.connect(p.DIRECT)
-    p.setGravity(0.0, 0.0, P.NATURAL_GRAVITY, physicsClientId=cid)
-    p.setTimeStep(1.0 / sim_hz, physicsClientId=cid)
-    shape = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=cid)
-    visual = p.createVisualShape(p.GEOM_BOX, halfExtents=[20, 2, 0.005], rgbaColor=[0.85, 0.85, 0.8, 1],
-                                 visualFramePosition=[0, 0, -0.005], physicsClientId=cid)
-    ground = p.createMultiBody(0, shape, visual, physicsClientId=cid)
-    robot = p.loadURDF(str(write_urdf(body, rgba)), useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE,
-                       physicsClientId=cid)
-    n = p.getNumJoints(robot, physicsClientId=cid)
-    names = [p.getJointInfo(robot, i, physicsClientId=cid)[1].decode() for i in range(n)]
-    p.changeDynamics(ground, -1, lateralFriction=friction, restitution=0.0, physicsClientId=cid)
-    for i in range(-1, n):
-        p.changeDynamics(robot, i, lateralFriction=friction, restitution=0.0, linearDamping=0.0,
-                         angularDamping=0.0, jointDamping=0.0, physicsClientId=cid)
-    p.setJointMotorControlArray(robot, list(range(n)), p.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=cid)
-    p.resetJointState(robot, names.index("root_z"), body.hip_height + 1e-4, physicsClientId=cid)
-    return cid, robot, ground, names
+    Raises:
+        JtError: the simulator has no planar world.
+    """
+    from toolkit import plugins
+
+    factory = getattr(plugins.load("sim", str(sim)), "planar_world", None)
+    if factory is None:
+        raise JtError(f"sim={sim} has no planar world (planar_world); standing_jump runs on "
+                      "sim=bullet")
+    world = factory(write_urdf(body, rgba), sim_hz=sim_hz, friction=friction,
+                    gravity=P.NATURAL_GRAVITY)
+    world.reset_joint(world.joint_names.index("root_z"), body.hip_height + 1e-4)
+    return world
+
+
+def open_world(body: Body, friction: float, sim_hz: float,
+               rgba: tuple = (0.55, 0.36, 0.2, 1.0), sim: str = "bullet") -> tuple[int, int, int, list[str]]:
+    """``planar_world`` as raw PyBullet handles, for tests that check against PyBullet itself.
+
+    Returns:
+        ``(client id, robot id, ground id, joint names)``; the caller disconnects the client.
+    """
+    w = planar_world(body, friction, sim_hz, rgba, sim)
+    return w.client, w.robot, w.ground, list(w.joint_names)
 
 
 def simulate(point: dict[str, float], settings: Optional[SimSettings] = None, record: bool = False,
@@ -148,8 +171,6 @@ def simulate(point: dict[str, float], settings: Optional[SimSettings] = None, re
         trace: if a list, one ``(t, phase, com_x, com_z, com_vx, com_vz, pelvis pitch, chest pitch,
             angular momentum about the CoM)`` tuple per step is appended.
     """
-    import pybullet as p
-
     st = settings or SimSettings()
     body = build_body(st.mass, st.height)
     g0, t_assist = P.assist(point, st.assist_deadzone)
@@ -160,19 +181,40 @@ def simulate(point: dict[str, float], settings: Optional[SimSettings] = None, re
         return g0 + (P.NATURAL_GRAVITY - g0) * (t / t_assist)
 
     ctrl = JumpController(body, P.phase_targets(point), st.timing, gravity)
-    cid, robot, ground, names = open_world(body, st.friction, st.sim_hz)
+    world = planar_world(body, st.friction, st.sim_hz, sim=st.sim)
     try:
-        ep = _Episode(p, cid, robot, ground, names, body, ctrl, st)
+        ep = _Episode(world, body, ctrl, st)
         return ep.run(gravity, g0, t_assist, record, record_every, trace)
     finally:
-        p.disconnect(cid)
+        world.close()
 
 
-def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
-    """A bound jt SPD backend for the PyBullet body, from the registry (``jt.spd``).
+def spd_solver(spd: Any) -> Any:
+    """An (unbound) jt SPD backend from the registry (``jt.spd``) that returns torques.
 
     Args:
         spd: the ``spd`` group (dict or config node; ``name`` picks the backend), or None for maba.
+
+    Raises:
+        UnusableSPD: the backend computes its torques inside the simulation step (``bullet``).
+    """
+    from toolkit import plugins
+    from toolkit.interfaces.plugin import Plugin
+
+    name = str(spd["name"]) if spd is not None and "name" in spd else "maba"
+    backend = plugins.load("spd", name)({"name": name, **Plugin.params_of(spd)})
+    if getattr(backend, "steps_itself", False):
+        raise UnusableSPD(f"spd={name} computes its torques inside stepSimulation; standing_jump "
+                          "needs the torques (it adds the virtual-force torques and applies "
+                          "limits): use maba, df, sf or pcg")
+    return backend
+
+
+def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
+    """A bound jt SPD backend for a raw PyBullet body (tests checking against PyBullet's M and C).
+
+    Args:
+        spd: the ``spd`` group (see ``spd_solver``), or None for maba.
         client: PyBullet client id.
         body: body id.
 
@@ -180,16 +222,9 @@ def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
         ``(backend, model)``: the backend bound to ``Model.from_bullet(client, body)`` (fixed base,
         then the three root joints and the 16 hinges in PyBullet joint order), and that model.
     """
-    from toolkit import plugins
     from toolkit.dynamics.model import Model
-    from toolkit.interfaces.plugin import Plugin
 
-    name = str(spd["name"]) if spd is not None and "name" in spd else "maba"
-    backend = plugins.load("spd", name)({"name": name, **Plugin.params_of(spd)})
-    if getattr(backend, "steps_itself", False):
-        raise ValueError(f"spd={name} computes its torques inside stepSimulation; standing_jump "
-                         "needs the torques (it adds the virtual-force torques and applies "
-                         "limits): use maba, df, sf or pcg")
+    backend = spd_solver(spd)
     model = Model.from_bullet(client, body)
     backend.bind(model)
     return backend, model
@@ -198,12 +233,12 @@ def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
 class _Episode:
     """The simulation loop of one jump and what it measures."""
 
-    def __init__(self, p: Any, cid: int, robot: int, ground: int, names: list[str], body: Body,
-                 ctrl: JumpController, st: SimSettings) -> None:
-        self.p, self.cid, self.robot, self.ground, self.body, self.ctrl, self.st = p, cid, robot, ground, body, ctrl, st
+    def __init__(self, world: Any, body: Body, ctrl: JumpController, st: SimSettings) -> None:
+        self.world, self.body, self.ctrl, self.st = world, body, ctrl, st
+        names = world.joint_names
         self.n = len(names)
         self.kin = PlanarKinematics(body, names)
-        link_of = {p.getJointInfo(robot, i, physicsClientId=cid)[12].decode(): i for i in range(self.n)}
+        link_of = {name: i for i, name in enumerate(world.link_names)}
         self.body_index = {link_of[link.name]: k for k, link in enumerate(body.links)}
         self.feet = ctrl.feet
         self.jidx = [names.index(link.joint) for link in body.links[1:]]
@@ -213,21 +248,23 @@ class _Episode:
         self.spd: Any = None  # a bound jt SPD backend (None: explicit PD)
         self.model: Any = None  # its toolkit.dynamics Model
         if st.stable_pd:
-            self.spd, self.model = spd_backend(st.spd, cid, robot)
+            self.spd = spd_solver(st.spd)
+            self.model = world.model()
+            self.spd.bind(self.model)
 
     def set_gravity(self, g: float) -> None:
-        """Vertical gravity ``g`` (m/s²) for PyBullet and for the SPD model's bias forces."""
-        self.p.setGravity(0.0, 0.0, g, physicsClientId=self.cid)
+        """Vertical gravity ``g`` (m/s²) for the world and for the SPD model's bias forces."""
+        self.world.set_gravity(g)
         if self.spd is not None:
             self.model.gravity[:] = (0.0, 0.0, g)  # the kernels read this array on every solve
 
     def contacts(self) -> dict[int, float]:
         """``{link index: total normal force}`` of the character's links touching the ground."""
         out: dict[int, float] = {}
-        for c in self.p.getContactPoints(self.robot, self.ground, physicsClientId=self.cid):
-            k = self.body_index.get(c[3])
+        for link, force in self.world.ground_contacts():
+            k = self.body_index.get(link)
             if k is not None:
-                out[k] = out.get(k, 0.0) + c[9]
+                out[k] = out.get(k, 0.0) + force
         return out
 
     def torques(self, q: list, qd: list, fr: Any, contacts: dict[int, float], dt: float) -> list[float]:
@@ -247,9 +284,8 @@ class _Episode:
 
     def run(self, gravity, g0: float, t_assist: float, record: bool, record_every: float,
             trace: Optional[list]) -> JumpResult:
-        p, cid, robot, ctrl, st, body, kin = self.p, self.cid, self.robot, self.ctrl, self.st, self.body, self.kin
+        world, ctrl, st, body, kin = self.world, self.ctrl, self.st, self.body, self.kin
         dt = 1.0 / st.sim_hz
-        all_j = list(range(self.n))
         e_je = e_se = 0.0
         lift = (0.0, 0.0, 0.0)
         apex_head = apex_com = -math.inf
@@ -263,9 +299,7 @@ class _Episode:
         q: list = []
         fr = None
         for step in range(int(st.max_time * st.sim_hz)):
-            js = p.getJointStates(robot, all_j, physicsClientId=cid)
-            q = [s[0] for s in js]
-            qd = [s[1] for s in js]
+            q, qd = world.joint_states()
             fr = kin.frame(q, qd)
             if not all(math.isfinite(v) for v in fr.com + fr.com_vel) or abs(fr.com_vel[0]) + abs(fr.com_vel[1]) > 50.0:
                 reason = "unstable"
@@ -314,8 +348,8 @@ class _Episode:
                 self.set_gravity(g)
             elif t_land is not None and t_assist > 0.0:
                 self.set_gravity(P.NATURAL_GRAVITY)
-            p.setJointMotorControlArray(robot, all_j, p.TORQUE_CONTROL, forces=forces, physicsClientId=cid)
-            p.stepSimulation(physicsClientId=cid)
+            world.apply_torques(forces)
+            world.step()
         else:
             reason = "no_landing" if t_land is None else "no_recovery"
 
