@@ -14,22 +14,7 @@ from typing import Any, Optional, Sequence
 
 from toolkit import plugins
 from toolkit.errors import JtError
-
-
-@dataclasses.dataclass
-class RunConfig:
-    """Top-level keys of ``conf/config.yaml`` (the groups are checked by their plugins)."""
-
-    seed: int = 0
-    """Seed of the run; evaluation seeds derive from it."""
-    store: str = "artifacts"
-    """Store root: ``mlflow.db`` and artifact folders (``store=PATH`` or ``JT_STORE``)."""
-    resume: Optional[str] = None
-    """Run id of an interrupted run to continue instead of starting a new one."""
-    profile: str = "default"
-    """Name of the experiment preset applied (set by ``experiment=...``)."""
-    run_name: Optional[str] = None
-    """Optional MLflow run name."""
+from toolkit.schema import RunConfig, config_of, validate  # noqa: F401 - re-exported
 
 
 def conf_dir() -> Path:
@@ -127,11 +112,48 @@ def _one_line(e: BaseException) -> str:
     return lines[0]
 
 
+def _defer(ov: Any) -> bool:
+    """A ``group.key=value`` assignment applied on the typed group after composition (so that the
+    key is checked against the group's schema, not against what its YAML happens to list)."""
+    from hydra.core.override_parser.types import OverrideType
+
+    key = ov.key_or_group
+    if "." not in key or "/" in key or ov.package or ov.is_sweep_override():
+        return False
+    return ov.type in (OverrideType.CHANGE, OverrideType.ADD, OverrideType.FORCE_ADD)
+
+
+def _choice(parsed: Sequence[Any], group: str) -> Optional[str]:
+    """The ``group=...`` choice on the command line, else the primary config's default."""
+    for ov in reversed(list(parsed)):
+        if ov.key_or_group == group and not ov.is_delete() and isinstance(ov.value(), str):
+            return str(ov.value())
+    from omegaconf import OmegaConf
+
+    for entry in OmegaConf.load(conf_dir() / "config.yaml").get("defaults", []):
+        if OmegaConf.is_dict(entry) and group in entry:
+            return None if entry[group] is None else str(entry[group])
+    return None
+
+
+def _preset(parsed: Sequence[Any]) -> list[str]:
+    """``preset=<experiment>_<task>`` when such a preset exists (it may choose groups itself)."""
+    if _choice(parsed, "preset") is not None:
+        return []
+    name = f"{_choice(parsed, 'experiment') or 'default'}_{_choice(parsed, 'task')}"
+    return [f"preset={name}"] if name in group_options("preset") else []
+
+
 def compose(overrides: Sequence[str] = ()) -> Any:
     """Compose ``conf/config.yaml`` with ``overrides`` (Hydra syntax), checked and typed.
 
+    Hydra composes the defaults lists: the task's own group choices (``override /spd: df`` in
+    ``conf/task/<task>.yaml``), then the experiment's per-task preset ``preset/<experiment>_<task>``
+    (which may choose groups too), then the command line, which wins. ``group.key=value``
+    assignments are applied afterwards on the group typed by its schema (``toolkit.schema``).
+
     Returns:
-        An OmegaConf ``DictConfig``; plugin groups are typed by their plugins' ``Config``.
+        An OmegaConf ``DictConfig``; every group typed by its schema, struct.
 
     Raises:
         JtError: one line naming what is wrong and, for choices, the valid ones.
@@ -140,67 +162,32 @@ def compose(overrides: Sequence[str] = ()) -> Any:
     from hydra import initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
+    from toolkit.schema import validate
+
     overrides = list(overrides)
     parsed = _parse(overrides)
     _check_choices(parsed)
+    hydra_overrides, deferred = [], []
+    for text, ov in zip(overrides, parsed):
+        if _defer(ov):
+            deferred.append((ov.key_or_group, ov.value()))
+        else:
+            hydra_overrides.append(text)
+    hydra_overrides += _preset(parsed)
     extra = _search_path()
     if extra:
-        overrides = overrides + ["hydra.searchpath=[" + ",".join(extra) + "]"]
+        hydra_overrides.append("hydra.searchpath=[" + ",".join(extra) + "]")
     GlobalHydra.instance().clear()
     try:
         with initialize_config_dir(config_dir=str(conf_dir()), version_base=None):
-            cfg = hydra_compose("config", overrides=overrides)
+            cfg = hydra_compose("config", overrides=hydra_overrides)
     except JtError:
         raise
     except Exception as e:  # noqa: BLE001 - Hydra/OmegaConf raise many types; one line each
         raise JtError(f"config: {_one_line(e)}") from e
     finally:
         GlobalHydra.instance().clear()
-    return validate(cfg)
-
-
-def validate(cfg: Any) -> Any:
-    """Type-check the top level and each plugin group against its plugin's ``Config``."""
-    from omegaconf import OmegaConf
-
-    OmegaConf.set_struct(cfg, False)
-    top = {k: cfg[k] for k in (f.name for f in dataclasses.fields(RunConfig)) if k in cfg}
-    try:
-        OmegaConf.merge(OmegaConf.structured(RunConfig), top)
-    except Exception as e:  # noqa: BLE001
-        raise JtError(f"config: {_one_line(e)}") from e
-    for group in plugins.KINDS:
-        node = cfg.get(group)
-        if node is None or not OmegaConf.is_dict(node) or "name" not in node:
-            continue
-        cls = plugins.load(group, str(node.name))
-        cfg[group] = typed_group(group, cls, node)
-    OmegaConf.set_struct(cfg, True)
-    return cfg
-
-
-def typed_group(group: str, cls: Any, node: Any) -> Any:
-    """Merge a group node into the plugin's ``Config`` schema (unknown key / wrong type → JtError)."""
-    from omegaconf import OmegaConf
-
-    schema_cls = getattr(cls, "Config", None)
-    if schema_cls is None or not dataclasses.is_dataclass(schema_cls):
-        return node
-    schema = OmegaConf.structured(schema_cls)
-    if "name" not in schema:
-        OmegaConf.set_struct(schema, False)
-        schema.name = str(node.name)
-        OmegaConf.set_struct(schema, True)
-    try:
-        return OmegaConf.merge(schema, node)
-    except Exception as e:  # noqa: BLE001
-        msg = str(e).strip().splitlines()[0]
-        if "not in" in msg or "Key '" in msg:
-            valid = ", ".join(f.name for f in dataclasses.fields(schema_cls) if f.name != "name")
-            raise JtError(f"{group}={node.name}: {msg} (valid keys: {valid})") from e
-        key = getattr(e, "full_key", None)
-        where = f"{group}.{key}" if key else f"{group}={node.name}"
-        raise JtError(f"{where}: {msg}") from e
+    return validate(cfg, deferred)
 
 
 def to_yaml(cfg: Any) -> str:
@@ -225,49 +212,6 @@ def flatten(cfg: Any) -> dict[str, str]:
 
     walk("", OmegaConf.to_container(cfg, resolve=True))
     return out
-
-
-def config_of(config_cls: type, cfg: Any, what: str = "config") -> Any:
-    """A typed ``Config`` dataclass instance from ``None``, an instance, a dataclass, a dict or a
-    group node — the one way every plugin parses its parameters.
-
-    Values are type-checked and converted through OmegaConf's structured configs (``"0.7"`` is
-    rejected for a float, ``1`` becomes ``1.0``). A ``name`` key is dropped unless ``config_cls``
-    declares it.
-
-    Args:
-        config_cls: the plugin's ``Config`` dataclass.
-        cfg: its parameters.
-        what: how to name the plugin in an error (``reward term safety``).
-
-    Raises:
-        JtError: an unknown key (the message lists the valid ones) or a value of the wrong type.
-    """
-    if cfg is None:
-        return config_cls()
-    if isinstance(cfg, config_cls):
-        return cfg
-    from omegaconf import OmegaConf
-
-    if dataclasses.is_dataclass(cfg):
-        params = dataclasses.asdict(cfg)
-    elif isinstance(cfg, dict):
-        params = dict(cfg)
-    else:
-        params = OmegaConf.to_container(cfg, resolve=True)
-    known = {f.name for f in dataclasses.fields(config_cls)}
-    if "name" not in known:
-        params.pop("name", None)
-    unknown = sorted(set(params) - known)
-    if unknown:
-        valid = ", ".join(sorted(known - {"name"}))
-        raise JtError(f"{what}: unknown key(s) {', '.join(unknown)} (valid keys: {valid})")
-    try:
-        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(config_cls), params))
-    except Exception as e:  # noqa: BLE001 - OmegaConf raises several validation types
-        msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        key = getattr(e, "full_key", None)
-        raise JtError(f"{what}: {key + ': ' if key else ''}{msg}") from e
 
 
 def group_of(cfg: Any, key: str) -> Any:

@@ -32,13 +32,20 @@ class CVAEActionSpace(PVAEActionSpace):
     @dataclasses.dataclass
     class Config:
         name: str = "cvae"
-        prior: str = ""  # the C-VAE prior: path to prior.h5 (or a folder with one) or the MLflow run id
-        store: str = ""  # store to look a run id up in (YAML: the run's store; "" = $JT_STORE, else ./artifacts)
-        latent_bound: float = 3.0  # ours: latent action bound, in std of the data's latent cloud
-        offset_bound: float = 1.0  # ours: offset bound per DoF (rad)
-        beta: float = 0.2  # 003 §3.4: action filter y_t = beta a_t + (1 - beta) y_{t-1}
-        c: float = 10.0  # 003 eq 3: naturalness scale of ||Δq||_1
-        clip_to_limits: bool = True  # keep targets within the joint limits (toolkit.priors.limits)
+        prior: str = ""
+        """Prior.h5 path (or a folder with one) or the MLflow run id of a pose_prior run."""
+        store: str = ""
+        """Store to look a run id up in: the run's own store by default."""
+        latent_bound: float = 3.0
+        """Ours: |z'| bound, in std of the data's latent cloud (whitened latents)."""
+        offset_bound: float = 1.0
+        """Ours: |dq'| bound per DoF (rad)."""
+        beta: float = 0.2
+        """003 §3.4: action filter coefficient."""
+        c: float = 10.0
+        """003 eq 3: "a constant value of c = 10 was sufficient"."""
+        clip_to_limits: bool = True
+        """Targets within the joint limits."""
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)

@@ -58,9 +58,12 @@ class FFCFBCActionSpace(DofActionSpace):
     @dataclasses.dataclass
     class Config:
         name: str = "ffc_fbc"
-        clip: str = "walk"  # reference clip: a name in pybullet_data's motions (walk, run, backflip, ...) or a path
-        correction_bound: float = 1.0  # ours: bound of each correction Δq (rad); 002 gives none
-        clip_to_limits: bool = True  # keep targets within the joint limits (toolkit.priors.limits)
+        clip: str = "walk"
+        """Reference clip: a pybullet_data motion name (walk, run, backflip, ...) or a path."""
+        correction_bound: float = 1.0
+        """Ours: |dq| bound per DoF (rad); 002 gives none."""
+        clip_to_limits: bool = True
+        """Targets within the joint limits."""
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)

@@ -31,13 +31,20 @@ class PVAEActionSpace(DofActionSpace):
     @dataclasses.dataclass
     class Config:
         name: str = "pvae"
-        prior: str = ""  # the prior: path to prior.h5 (or a folder with one) or the MLflow run id that made it
-        store: str = ""  # store to look a run id up in (YAML: the run's store; "" = $JT_STORE, else ./artifacts)
-        latent_bound: float = 3.0  # ours: latent action bound, in std of the data's latent cloud
-        offset_bound: float = 1.0  # ours: offset bound per DoF (rad); the authors' code bounds actions to [-1, 1]
-        c_offset: float = 15.0  # 000 §6.1.2: c_offset = 48 - 33 clip(rho, 0, 1), i.e. 15 once rho >= 1
-        episode_average: bool = False  # 000 §4.2: sparse-reward tasks use the episode's mean ||a_offset||_1
-        clip_to_limits: bool = True  # keep targets within the joint limits (toolkit.priors.limits)
+        prior: str = ""
+        """Prior.h5 path (or a folder with one) or the MLflow run id of a pose_prior run."""
+        store: str = ""
+        """Store to look a run id up in: the run's own store by default."""
+        latent_bound: float = 3.0
+        """Ours: |a_latent| bound, in std of the data's latent cloud (whitened latents)."""
+        offset_bound: float = 1.0
+        """Ours: |a_offset| bound per DoF (rad); offsets on all internal DoFs (000 §4.2)."""
+        c_offset: float = 15.0
+        """000 eq 4 / §6.1.2: c_offset = 48 - 33 clip(rho, 0, 1) -> 15 at rho >= 1 (curriculum sets it)."""
+        episode_average: bool = False
+        """000 §4.2: sparse-reward tasks use the episode mean of ||a_offset||_1."""
+        clip_to_limits: bool = True
+        """Targets within the joint limits."""
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)

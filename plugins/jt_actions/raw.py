@@ -20,7 +20,8 @@ class RawActionSpace(DofActionSpace):
     @dataclasses.dataclass
     class Config:
         name: str = "raw"
-        clip_to_limits: bool = True  # keep targets within the joint limits (toolkit.priors.limits)
+        clip_to_limits: bool = True
+        """Targets within the joint limits (URDF revolute ranges; |exp map| <= pi)."""
 
     @property
     def dim(self) -> int:

@@ -26,19 +26,32 @@ class BarHeightCurriculum(IterationCurriculum):
 
     @dataclasses.dataclass
     class Config:
-        z_min: float = 0.5  # starting bar height, m (000 Table 1: 50 cm)
-        z_max: float = 2.0  # highest bar, m (000 Table 1: 200 cm)
-        dz: float = 0.01  # increment Δz, m (000 Table 1: 1 cm)
-        reward_threshold: float = 30.0  # accumulated-reward threshold R_T (000 Table 1)
-        z_freeze: Optional[float] = 1.0  # m; frozen() from here on, null = never (000 §6.1.4: 100 cm)
-        rho_scale: float = 2.0  # ρ = rho_scale·z + rho_offset; high jump ρ = 2z − 1 (000 §6.1.3)
-        rho_offset: float = -1.0  # see rho_scale (000 §6.1.3)
-        control_hz_start: float = 10.0  # f_control at ρ ≤ 0, Hz (000 §6.1.3: 10 + 20·Clip(ρ,0,1))
-        control_hz_span: float = 20.0  # f_control rise up to ρ = 1, Hz (000 §6.1.3)
-        c_offset_start: float = 48.0  # c_offset at ρ ≤ 0 (000 §6.1.3: 48 − 33·Clip(ρ,0,1))
-        c_offset_span: float = 33.0  # c_offset drop up to ρ = 1 (000 §6.1.3)
-        signal: str = "mean_return"  # iteration stat accumulated: mean_return | mean_reward (docs: deviations)
-        z_attr: str = "bar_height"  # environment attribute that receives z
+        z_min: float = 0.5
+        """50 cm (000 Table 1)."""
+        z_max: float = 2.0
+        """200 cm (000 Table 1)."""
+        dz: float = 0.01
+        """Δz = 1 cm (000 Table 1)."""
+        reward_threshold: float = 30.0
+        """R_T (000 Table 1)."""
+        z_freeze: Optional[float] = 1.0
+        """Strategy discovery stops at 100 cm; null = train to z_max (000 §6.1.4)."""
+        rho_scale: float = 2.0
+        """Ρ = 2z − 1 for high jumps (000 §6.1.3)."""
+        rho_offset: float = -1.0
+        """(000 §6.1.3)."""
+        control_hz_start: float = 10.0
+        """F_control = 10 + 20·Clip(ρ, 0, 1) Hz (000 §6.1.3)."""
+        control_hz_span: float = 20.0
+        """(000 §6.1.3)."""
+        c_offset_start: float = 48.0
+        """C_offset = 48 − 33·Clip(ρ, 0, 1) (000 §6.1.3, eq 4)."""
+        c_offset_span: float = 33.0
+        """(000 §6.1.3)."""
+        signal: str = "mean_return"
+        """Accumulated stat: mean episode return of the iteration (jt reading of "average sample reward", see docs)."""
+        z_attr: str = "bar_height"
+        """Environment attribute receiving z (jt)."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

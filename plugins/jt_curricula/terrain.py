@@ -21,13 +21,20 @@ class TerrainCurriculum(IterationCurriculum):
     @dataclasses.dataclass
     class Config:
         regions: list[str] = dataclasses.field(
-            default_factory=lambda: ["flat", "easy", "medium", "hard"])  # in order of difficulty (003 §5.4, Fig. 3)
-        successes_to_unlock: int = 200  # successful get-ups that unlock the next region (003 §5.4)
-        frontier_only: bool = True  # count only successes on the newest unlocked region (ours; 003 is silent)
-        fixed_every_samples: int = 0  # >0: unlock every this many samples instead (003 §6.4 ablations: 20e6)
-        success_key: str = "success"  # episode key of the success flag
-        region_key: str = "terrain_level"  # episode key of the region index it ran on (if the task logs it)
-        level_attr: str = "terrain_level"  # environment attribute: highest unlocked region index
+            default_factory=lambda: ["flat", "easy", "medium", "hard"])
+        """Four regions in order of difficulty (003 §5.4, Fig. 3)."""
+        successes_to_unlock: int = 200
+        """Successes needed to unlock the next region (003 §5.4)."""
+        frontier_only: bool = True
+        """Count successes on the newest region only (jt; 003 does not say)."""
+        fixed_every_samples: int = 0
+        """0 = adaptive; 20000000 = the fixed schedule of 003's ablations (003 §6.4)."""
+        success_key: str = "success"
+        """Episode key of the success flag (jt)."""
+        region_key: str = "terrain_level"
+        """Episode key of the region an episode ran on (jt)."""
+        level_attr: str = "terrain_level"
+        """Environment attribute: highest unlocked region; envs sample 0..level (jt; 003 §5.4 "revisits all unlocked regions")."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

@@ -37,17 +37,28 @@ class BDSSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
-        budget: int = 10  # total evaluations, initial samples included; 000 §7.1.1 counts the first ten
-        batch: int = 1  # points per ask; 1 = Alg. 1 exactly (000 §5.1); >1 = batch BDS (docs/searchers.md)
-        n_init: int = 3  # random samples that initialise the GP (000 Alg. 1 line 2 gives no number; ours)
-        n_exp: int = 3  # exploration picks per round (000 §6.2)
-        n_opt: int = 3  # diversity picks per round (000 §6.2)
-        init_method: str = "uniform"  # "uniform" or "sobol" for the initial samples
-        n_mc: int = 128  # Monte-Carlo draws for eq 7 (fixed, seeded)
-        direct_maxfun: int = 2000  # DIRECT evaluation budget per diversity pick
-        lbfgs_starts: int = 8  # L-BFGS-B starts per exploration pick (best of 512 candidates + random)
-        gp_restarts: int = 3  # extra seeded starts of the marginal-likelihood optimisation
-        feature_distance: Optional[str] = None  # "euclidean" | "angle" | "quaternion"; None: the task's
+        budget: int = 10
+        """Total evaluations incl. initial samples; 000 §7.1.1 reports the first ten."""
+        batch: int = 1
+        """1 = Algorithm 1 as published; >1 = batch BDS (kriging believer, ours; 000 §8 future work)."""
+        n_init: int = 3
+        """Random samples initialising the GP (000 Alg. 1 line 2 gives no number; ours)."""
+        n_exp: int = 3
+        """Exploration picks per round, argmax posterior std by L-BFGS (000 §6.2, eq 9)."""
+        n_opt: int = 3
+        """Diversity picks per round, argmax eq 7 by DIRECT (000 §6.2)."""
+        init_method: str = "uniform"
+        """"uniform" or "sobol" initial samples (000 Alg. 1: "random samples")."""
+        n_mc: int = 128
+        """Monte-Carlo draws for eq 7, fixed and seeded (000 §5.1 uses MC; count ours)."""
+        direct_maxfun: int = 2000
+        """DIRECT evaluations per diversity pick (ours; 000 §5.1: "does not have to be perfectly accurate")."""
+        lbfgs_starts: int = 8
+        """L-BFGS-B starts per exploration pick (ours)."""
+        gp_restarts: int = 3
+        """Extra seeded restarts of the GP marginal-likelihood fit (ours)."""
+        feature_distance: Optional[str] = None
+        """Euclidean | angle | quaternion; null = the task's (SearchProblem.feature_distance)."""
 
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)

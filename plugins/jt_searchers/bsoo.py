@@ -48,19 +48,32 @@ class BSOOSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
-        budget: int = 2000  # total evaluations, shared by the bins (004 runs every bin to convergence)
-        batch: int = 16  # points per ask: one CMA-ES generation (004 §4.1: 16 offspring)
-        n_bins: int = 16  # uniformly spaced bins of objective 1 (004 §4.1)
-        popsize: int = 16  # CMA-ES offspring per generation (004 §4.1)
-        sigma0: float = 0.015  # initial CMA-ES step size in the box-normalised space (004 §4.1)
-        stall_generations: int = 300  # stop a bin when its best improved < eps over this span (004 §4.1)
-        max_generations: int = 3000  # generation cap per bin (004 §4.1)
-        eps: float = 1e-8  # improvement threshold epsilon (004 §4.1 does not give its value; ours)
-        w_p: float = 5000.0  # weight of the bin (height) penalty, eq 2 (004 §3.2)
-        f_p: float = 100000.0  # failure penalty, eq 3 (004 §3.2)
-        bin_low: Optional[float] = None  # objective-1 range split into bins; None: range of a random
-        bin_high: Optional[float] = None  # sample of `range_samples` points (+ the input controller)
-        range_samples: int = 15  # random points that set the bin range when bin_low/bin_high are None (ours)
+        budget: int = 2000
+        """Total evaluations, shared evenly by the remaining bins (ours; 004 runs every bin to convergence)."""
+        batch: int = 16
+        """One CMA-ES generation per ask (004 §4.1: 16 offspring)."""
+        n_bins: int = 16
+        """Uniformly spaced bins of objective 1 (004 §4.1)."""
+        popsize: int = 16
+        """CMA-ES offspring per generation (004 §4.1)."""
+        sigma0: float = 0.015
+        """Initial CMA-ES step size, box-normalised space (004 §4.1)."""
+        stall_generations: int = 300
+        """Stop a bin after 300 generations with less than eps improvement (004 §4.1)."""
+        max_generations: int = 3000
+        """... or after 3000 generations (004 §4.1)."""
+        eps: float = 1e-8
+        """Improvement threshold epsilon (004 §4.1 gives no value; ours)."""
+        w_p: float = 5000.0
+        """Bin (height) penalty weight, eq 2 (004 §3.2)."""
+        f_p: float = 100000.0
+        """Failure penalty, eq 3 (004 §3.2)."""
+        bin_low: Optional[float] = None
+        """Objective-1 range split into bins; null = min/max over a random sample (ours)."""
+        bin_high: Optional[float] = None
+        """(upper end; see bin_low)."""
+        range_samples: int = 15
+        """Size of that random sample, used only when bin_low/bin_high are null (ours)."""
 
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)

@@ -43,9 +43,12 @@ class RandomSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
-        budget: int = 10  # total evaluations; 000 §7.2.1 compares the first ten samples
-        batch: int = 1  # points per ask (evaluated in parallel by the runner)
-        method: str = "uniform"  # "uniform" (i.i.d.) or "sobol" (scrambled Sobol', scipy.stats.qmc)
+        budget: int = 10
+        """Total evaluations; 000 §7.2.1 compares the first ten samples."""
+        batch: int = 1
+        """Points per ask (evaluated in parallel by the runner)."""
+        method: str = "uniform"
+        """"uniform" (i.i.d.) or "sobol" (scrambled Sobol', scipy.stats.qmc)."""
 
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)

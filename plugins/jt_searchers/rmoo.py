@@ -38,16 +38,25 @@ class RMOOSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
-        budget: int = 2000  # total evaluations (004 runs until converged; a budget bounds the run)
-        batch: int = 16  # points per ask: a generation's mu children run in parallel (004 §4.3.1)
-        mu: int = 16  # parents (004 §5: "RMOO with mu = 16")
-        sigma0: float = 0.015  # initial step size, unit-cube units (BSOO's, 004 §4.1; RMOO's not stated)
-        max_failed: int = 3  # at most this many failed children per generation (004 §4.3.1)
-        max_resample_rounds: int = 20  # give up resampling after this many rounds in one generation (ours)
-        tol: float = 1e-9  # "change of fitness for all samples < epsilon" (004 Alg. 1; epsilon not given)
-        patience: int = 10  # generations the change must stay below tol (ours: one generation without a
+        budget: int = 2000
+        """Total evaluations (004 runs to convergence; the budget bounds a run)."""
+        batch: int = 16
+        """One generation of mu children evaluated in parallel (004 §4.3.1, multi-threaded)."""
+        mu: int = 16
+        """Parents (004 §5: "RMOO with mu = 16")."""
+        sigma0: float = 0.015
+        """Initial step size in the box-normalised space (004 §4.1 gives it for BSOO; reused)."""
+        max_failed: int = 3
+        """At most 3 failed children per generation, the rest resampled (004 §4.3.1)."""
+        max_resample_rounds: int = 20
+        """Give up resampling a generation after this many rounds (ours)."""
+        tol: float = 1e-9
+        """Converged when no parent's fitness changes more than this (004 Alg. 1; value ours)."""
+        patience: int = 10
+        """... for this many generations in a row (ours)."""
         # selected child is common for an elitist ES, so a single one does not mean convergence)
-        success: str = "parent"  # "parent": a child succeeds when it ranks above its parent (Igel et al.
+        success: str = "parent"
+        """A child succeeds when it ranks above its parent (Igel et al. 2007, followed by 004 §4.2.1); "selected": when selected into the next parents (Voss et al. 2010)."""
         # 2007, which 004 §4.2.1 follows); "selected": when it is selected into the next parents
         # (Voss, Hansen, Igel 2010, "Improved step size adaptation for the MO-CMA-ES")
 

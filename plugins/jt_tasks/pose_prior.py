@@ -42,18 +42,30 @@ class PosePriorTask(Task):
     @dataclasses.dataclass
     class Config:
         name: str = "pose_prior"
-        dataset: str = ""  # a pose dataset (python -m toolkit.motion.dataset); "" = build from pybullet_data
-        held_out: list[str] = dataclasses.field(default_factory=lambda: ["walk"])  # clips kept out of training
-        rate: float = 30.0  # Hz: resampling rate when building the dataset
-        mirror: bool = True  # add left/right mirrors when building the dataset
-        variance: float = 0.85  # 000 §4.2, 003 §3.5: latent size = PCA components covering this variance
-        latent_dim: int = 0  # a fixed latent size instead (0 = by PCA)
-        hidden: list[int] = dataclasses.field(default_factory=lambda: [256, 256])  # 000 §4.2, 003 §3.5
-        beta: Optional[float] = None  # KL weight; null = the paper's (pvae 1e-5, 000 §4.2; cvae 1e-6, 003 §3.5)
-        lr: float = 1e-4  # 000 §4.2, 003 §3.5: Adam learning rate
-        batch_size: int = 128  # 000 §4.2, 003 §3.5
-        epochs: Optional[int] = None  # null = as many Adam updates as the paper (see docs/priors.md)
-        samples: int = 8  # decoded random latents in prior_samples.png
+        dataset: str = ""
+        """A pose dataset (python -m toolkit.motion.dataset); "" = build from pybullet_data's 15 clips."""
+        held_out: list[str] = dataclasses.field(default_factory=lambda: ["walk"])
+        """Clips kept out of training, for recon_rmse_heldout vs pca_rmse_heldout."""
+        rate: float = 30.0
+        """Hz, when building the dataset (000 §6.1.3 top control rate)."""
+        mirror: bool = True
+        """Add left/right mirrors when building the dataset."""
+        variance: float = 0.85
+        """000 §4.2, 003 §3.5: latent size = PCA components covering 85 % of the variance."""
+        latent_dim: int = 0
+        """Fix the latent size instead (0 = by PCA)."""
+        hidden: list[int] = dataclasses.field(default_factory=lambda: [256, 256])
+        """000 §4.2, 003 §3.5: encoder/decoder 2 x 256 tanh."""
+        beta: Optional[float] = None
+        """Null = the paper's: 1e-5 for pvae (000 §4.2), 1e-6 for cvae (003 §3.5)."""
+        lr: float = 1e-4
+        """000 §4.2, 003 §3.5: Adam."""
+        batch_size: int = 128
+        """000 §4.2, 003 §3.5."""
+        epochs: Optional[int] = None
+        """Null = the paper's number of Adam updates (000: 80 epochs of ~20k poses; 003: 100 of ~36k) on our data; see docs/priors.md."""
+        samples: int = 8
+        """Decoded random latents in prior_samples.png."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

@@ -34,20 +34,33 @@ class StrategyLandscapeTask(Task):
 
     @dataclasses.dataclass
     class Config:
-        dims: int = 4  # exploration-space dimension (000 §7.2.1: a four-dimensional take-off space)
-        n_strategies: int = 12  # hidden strategy cells K
-        n_features: int = 2  # feature dimension
-        layout: str = "quantised"  # "quantised": nearest plateau to a smooth field; "voronoi": random cells
-        latent_scale: float = 0.12  # quantised: std of the linear latent field (smaller: more unequal);
+        dims: int = 4
+        """Exploration-space dimension (000 §8: "a four dimensional space")."""
+        n_strategies: int = 12
+        """Hidden strategy cells (plateaus)."""
+        n_features: int = 2
+        """Feature dimension."""
+        layout: str = "quantised"
+        """"quantised": nearest plateau to a smooth latent field; "voronoi": random cells."""
+        latent_scale: float = 0.12
+        """Quantised: std of the latent field (smaller = more unequal cells); voronoi: weight spread."""
         # voronoi: spread of the power-diagram weights
-        wiggle: float = 0.05  # quantised: amplitude of the latent field's nonlinear part
-        noise: float = 0.02  # std of the Gaussian noise added to the plateau features
-        min_separation: float = 0.2  # least distance between two plateau feature vectors
-        distinct_threshold: float = 0.1  # features closer than this count as one strategy
-        n_failing: int = 0  # the smallest cells are failures (no features), as falls are in 000 §7.1.1
-        landscape_seed: int = 0  # seed of the landscape (cells, plateaus); the run seed only drives noise
-        low: float = -1.0  # lower bound of every parameter
-        high: float = 1.0  # upper bound of every parameter
+        wiggle: float = 0.05
+        """Quantised: amplitude of the latent field's nonlinear part."""
+        noise: float = 0.02
+        """Std of the noise on the plateau features (000 §5.1: g is stochastic)."""
+        min_separation: float = 0.2
+        """Least distance between two plateau feature vectors."""
+        distinct_threshold: float = 0.1
+        """Features closer than this count as one strategy."""
+        n_failing: int = 0
+        """The smallest cells fail (falls; 000 §7.1.1 counts "repetitions or failures")."""
+        landscape_seed: int = 0
+        """Seed of the landscape itself (the run seed drives only the noise); conf/task/strategy_landscape.yaml selects 1, the landscape docs/searchers.md documents."""
+        low: float = -1.0
+        """Lower bound of every parameter."""
+        high: float = 1.0
+        """Upper bound of every parameter."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

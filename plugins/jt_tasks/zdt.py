@@ -60,8 +60,10 @@ class ZDT1Task(Task):
 
     @dataclasses.dataclass
     class Config:
-        n_var: int = 30  # number of variables (ZDT1's standard n = 30)
-        reference_point: list[float] = dataclasses.field(default_factory=lambda: [11.0, 11.0])  # hypervolume
+        n_var: int = 30
+        """ZDT1's standard number of variables."""
+        reference_point: list[float] = dataclasses.field(default_factory=lambda: [11.0, 11.0])
+        """Hypervolume reference: worse than any point of the box (f1 <= 1, f2 <= 10)."""
         # reference, worse than every point of the box
 
     def __init__(self, cfg: Any = None) -> None:

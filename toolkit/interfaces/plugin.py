@@ -22,10 +22,13 @@ class Plugin:
     Attributes:
         Config: dataclass of the plugin's parameters.
         name: the registry name, filled in by the registry when the class is loaded.
+        group_schemas: other config groups this plugin reads, with the dataclass that types each
+            (the ``bullet`` simulator types ``character``); checked at composition like ``Config``.
     """
 
     Config: ClassVar[type] = NoConfig
     name: ClassVar[str] = ""
+    group_schemas: ClassVar[dict[str, type]] = {}
 
     @classmethod
     def summary(cls) -> str:

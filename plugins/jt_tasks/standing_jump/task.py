@@ -39,26 +39,46 @@ class StandingJumpTask(Task):
     @dataclasses.dataclass
     class Config:
         name: str = "standing_jump"
-        sim_hz: float = 600.0  # simulation = control rate (Hz); 004 does not give Vortex's rate
-        mass: float = 80.0  # character mass, kg (004 §3)
-        height: float = 1.60  # character height, m (004 §3)
-        friction: float = 1.0  # foot-ground Coulomb friction
-        gains_scale: float = 1.0  # factor on every PD gain (the gains are fixed, 004 §3)
-        max_time: float = 6.0  # longest episode, s
-        landing_target: float = 0.0  # l_o: landing position relative to the start, m (004 eq 3)
-        landing_tolerance: float = 0.25  # l_r: landing bracket half-width, m (004 eq 3)
-        upright_fraction: float = 0.8  # at the end the head must be above this × its standing height
-        w_je: float = 1.0  # weight of the internal joint effort (004 §4.3.2)
-        w_se: float = 5000.0  # weight of the external effort; w_SE / w_JE = 5000 (004 §4.3.2)
-        w_p: float = 5000.0  # height-constraint weight of C_H (004 eq 2; used by BSOO)
-        f_p: float = 1.0e5  # failure penalty (004 eq 3)
-        assist_deadzone: float = 0.05  # take-off gravity within this of -9.8 m/s² is no assist at all
-        default_gravity: float = -11.0  # default take-off gravity parameter (≤ -9.8: natural)
-        default_assist_time: float = 0.5  # default assist duration, s
-        save_trajectory: bool = True  # write jump.h5 (CoM and head curves, events) per evaluation
-        filmstrips: bool = True  # summarize renders filmstrips of the key jumps
-        filmstrip_width: int = 160  # pixels per filmstrip frame
-        filmstrip_height: int = 240  # pixels per filmstrip frame
+        sim_hz: float = 600.0
+        """Simulation = control rate, Hz, with Stable PD (004 uses Vortex and gives no rate; 600 Hz as 000/001)."""
+        mass: float = 80.0
+        """Kg (004 §3: "weighs 80 kg")."""
+        height: float = 1.60
+        """M (004 §3: "160 cm tall")."""
+        friction: float = 1.0
+        """Foot-ground Coulomb friction (our choice)."""
+        gains_scale: float = 1.0
+        """Factor on the fixed, hand-tuned PD gains (004 §3)."""
+        max_time: float = 6.0
+        """Longest episode, s (our choice)."""
+        landing_target: float = 0.0
+        """L_o, m: an in-place jump lands where it started (004 §3.2, eq 3)."""
+        landing_tolerance: float = 0.25
+        """L_r, m: landing bracket (004 eq 3; the paper gives no value)."""
+        upright_fraction: float = 0.8
+        """Head above 0.8 × standing head height at the end, else a fall (our choice)."""
+        w_je: float = 1.0
+        """W_JE (004 §4.3.2)."""
+        w_se: float = 5000.0
+        """W_SE: w_SE / w_JE = 5000 (004 §4.3.2)."""
+        w_p: float = 5000.0
+        """C_H weight (004 §3.2, eq 2: "a value of 5000 for w_p")."""
+        f_p: float = 1.0e5
+        """Failure penalty (004 §3.2, eq 3: "f_p was set to ... 100000")."""
+        assist_deadzone: float = 0.05
+        """M/s²: smaller assists are exactly none (natural jumps use 0 force, 004 §5)."""
+        default_gravity: float = -11.0
+        """Take-off gravity of the seed controller (≤ -9.8 = natural; 004 §3.3)."""
+        default_assist_time: float = 0.5
+        """S, seed assist duration (irrelevant while natural; 004 Tables 2-3: 0.27-0.82 s)."""
+        save_trajectory: bool = True
+        """Jump.h5 per evaluation (CoM, head, angular momentum at 100 Hz; events)."""
+        filmstrips: bool = True
+        """Summarize: filmstrips of lowest/highest natural and highest supernatural (004 Fig. 9)."""
+        filmstrip_width: int = 160
+        """Px per frame."""
+        filmstrip_height: int = 240
+        """Px per frame."""
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

@@ -91,8 +91,8 @@ def test_count_distinct_leader_clustering() -> None:
 def test_config_from_the_composed_run_config() -> None:
     node = OmegaConf.load(Path(__file__).parents[3] / "conf" / "task" / "strategy_landscape.yaml")
     task = StrategyLandscapeTask(OmegaConf.create({"task": node}))
-    # the YAML holds the class defaults, except the landscape it selects (docs/searchers.md)
-    assert node.landscape_seed == 1
+    # the YAML holds only what it selects: the landscape of docs/searchers.md
+    assert set(node) == {"name", "landscape_seed"} and node.landscape_seed == 1
     assert task.params == dataclasses.replace(StrategyLandscapeTask.Config(), landscape_seed=1)
     with pytest.raises(JtError, match="unknown key"):
         StrategyLandscapeTask({"task": {"no_such_key": 1}})

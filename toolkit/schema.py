@@ -1,0 +1,303 @@
+"""Config schemas: every group typed by its ``Config`` dataclass, the one source of defaults.
+
+A default lives once, in a plugin's ``Config`` dataclass (each field with a docstring citing its
+source); YAML only selects and overrides. ``toolkit.config.compose`` lets Hydra compose the
+defaults lists (groups, presets, packages), then ``validate`` merges each group node into its
+schema and applies the command line's ``group.key=value`` overrides on the typed node, so that
+
+* an unknown key or a wrong type is one ``JtError`` line before anything runs,
+* a ``Config`` with a ``check()`` method range-checks its values there too,
+* ``jt run ... --cfg`` prints every value that will run, defaults included.
+
+Which schema types a group:
+
+* a plugin kind's group (``task``, ``spd``, ``search``, ...): the chosen plugin's ``Config``;
+* ``reward`` (a *set* of terms, no ``name``): each ``terms.<term>`` by that term's ``Config``;
+* groups a plugin declares in ``group_schemas`` (the ``bullet`` simulator types ``character``);
+* the core's own groups in ``CORE_GROUPS`` (``agent``: PPO's hyper-parameters).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import math
+from typing import Any, Optional, Sequence
+
+from toolkit import plugins
+from toolkit.errors import JtError
+
+#: groups typed by the core (not plugin kinds): group → ``module:Class``
+CORE_GROUPS: dict[str, str] = {"agent": "toolkit.rl.config:PPOConfig"}
+
+
+@dataclasses.dataclass
+class RunConfig:
+    """Top-level keys of ``conf/config.yaml`` (the groups are checked by their schemas)."""
+
+    seed: int = 0
+    """Seed of the run; evaluation seeds derive from it."""
+    store: str = "artifacts"
+    """Store root: ``mlflow.db`` and artifact folders (``store=PATH`` or ``JT_STORE``)."""
+    resume: Optional[str] = None
+    """Run id of an interrupted run to continue instead of starting a new one."""
+    profile: str = "default"
+    """Name of the experiment preset applied (set by ``experiment=...``)."""
+    run_name: Optional[str] = None
+    """Optional MLflow run name."""
+
+
+def _load_class(ref: str) -> type:
+    module, _, attr = ref.partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+def _first_line(e: BaseException) -> str:
+    text = str(e).strip()
+    return text.splitlines()[0].strip() if text else type(e).__name__
+
+
+def _valid_keys(cls: type) -> str:
+    return ", ".join(f.name for f in dataclasses.fields(cls) if f.name != "name")
+
+
+def structured(cls: type, name: Optional[str] = None) -> Any:
+    """The OmegaConf structured node of dataclass ``cls`` (struct: unknown keys are refused);
+    a ``name`` key is added when ``cls`` has none and ``name`` is given."""
+    from omegaconf import OmegaConf
+
+    node = OmegaConf.structured(cls)
+    if name is not None and "name" not in node:
+        OmegaConf.set_struct(node, False)
+        node.name = str(name)
+        OmegaConf.set_struct(node, True)
+    return node
+
+
+def typed_node(where: str, cls: type, node: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
+    """``node`` merged into ``cls``'s schema, then ``overrides`` ``[(dotted key, value)]`` applied.
+
+    Args:
+        where: how to name the group in an error (``task=highjump``, ``agent``).
+        cls: the schema dataclass.
+        node: the composed group node (DictConfig / dict / None).
+        overrides: command-line assignments inside this group, keys relative to it.
+
+    Returns:
+        The typed DictConfig.
+
+    Raises:
+        JtError: one line: an unknown key (with the valid ones), a wrong type, a value out of range.
+    """
+    from omegaconf import OmegaConf
+
+    name = None if node is None or "name" not in node else str(node["name"])
+    schema = structured(cls, name)
+    group = where.split("=")[0]
+    try:
+        merged = OmegaConf.merge(schema, node if node is not None else {})
+    except Exception as e:  # noqa: BLE001 - OmegaConf raises several validation types
+        raise _schema_error(where, cls, e) from e
+    for key, value in overrides:
+        try:
+            OmegaConf.update(merged, key, value, merge=True, force_add=False)
+        except Exception as e:  # noqa: BLE001
+            msg = _first_line(e)
+            if "not in" in msg or "Key '" in msg or "Could not" in msg:
+                raise JtError(f"unknown key '{group}.{key}' ({where}; valid keys: {_valid_keys(cls)})") from e
+            raise JtError(f"{group}.{key}={value}: {msg}") from e
+    return merged
+
+
+def check_node(where: str, cls: type, node: Any) -> None:
+    """Build the dataclass of a typed node in place (interpolations resolve against its root) and
+    run its ``check()``: a missing value or a bad range is one ``JtError`` line."""
+    from omegaconf import OmegaConf
+
+    try:
+        obj = OmegaConf.to_object(node)
+    except Exception as e:  # noqa: BLE001 - e.g. a missing mandatory value
+        raise _schema_error(where, cls, e) from e
+    check = getattr(obj, "check", None)
+    if callable(check):
+        check()
+
+
+def _schema_error(where: str, cls: type, e: BaseException) -> JtError:
+    msg = _first_line(e)
+    group = where.split("=")[0]
+    if "not in" in msg or "Key '" in msg:
+        return JtError(f"{where}: {msg} (valid keys: {_valid_keys(cls)})")
+    key = getattr(e, "full_key", None)
+    return JtError(f"{group + '.' + key if key else where}: {msg}")
+
+
+def _typed_reward(node: Any, overrides: Sequence[tuple[str, Any]]) -> Any:
+    """The reward group: ``terms.<term>`` each typed by the term plugin's ``Config``."""
+    from omegaconf import OmegaConf
+
+    terms = OmegaConf.to_container(node, resolve=False).get("terms") or {}
+    by_term: dict[str, list] = {}
+    for key, value in overrides:
+        parts = key.split(".")
+        if parts[0] != "terms" or len(parts) < 2:
+            raise JtError(f"unknown key 'reward.{key}' (the reward group holds terms.<term>.<key>)")
+        if parts[1] not in terms:
+            raise JtError(f"reward.{key}: the reward has no term '{parts[1]}'; its terms: {', '.join(terms)}")
+        if len(parts) == 2:
+            by_term.setdefault(parts[1], []).extend((k, v) for k, v in dict(value).items())
+        else:
+            by_term.setdefault(parts[1], []).append((".".join(parts[2:]), value))
+    typed = {}
+    for term, params in terms.items():
+        cls = getattr(plugins.load("reward", term), "Config", None)
+        if cls is None or not dataclasses.is_dataclass(cls):
+            typed[term] = params
+            continue
+        typed[term] = typed_node(f"reward.terms.{term}", cls, params or {}, by_term.get(term, ()))
+        check_node(f"reward.terms.{term}", cls, typed[term])
+    out = OmegaConf.create({"terms": typed})
+    OmegaConf.set_struct(out, True)
+    return out
+
+
+def _plugin_schema(group: str, node: Any) -> tuple[Optional[type], Optional[type]]:
+    """``(plugin class, schema)`` of a plugin-kind group node (``(None, None)`` if untyped)."""
+    if node is None or "name" not in node:
+        return None, None
+    cls = plugins.load(group, str(node["name"]))
+    schema = getattr(cls, "Config", None)
+    return cls, schema if schema is not None and dataclasses.is_dataclass(schema) else None
+
+
+def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
+    """Type every group of a composed config and apply the deferred group overrides.
+
+    Args:
+        cfg: Hydra's composed DictConfig.
+        overrides: ``[(dotted key, value)]`` assignments inside groups (``task.clip``), applied on
+            the typed nodes so that an unknown key names the group's valid keys.
+
+    Returns:
+        The validated config, struct (reading or setting an unknown key raises).
+    """
+    from omegaconf import OmegaConf
+
+    OmegaConf.set_struct(cfg, False)
+    by_group: dict[str, list[tuple[str, Any]]] = {}
+    for key, value in overrides:
+        group, _, rest = key.partition(".")
+        by_group.setdefault(group, []).append((rest, value))
+    allowed = {f.name for f in dataclasses.fields(RunConfig)} | set(plugins.KINDS) | set(CORE_GROUPS)
+    schemas: dict[str, type] = {}
+    checks: list[tuple[str, type, str]] = []
+    for group in plugins.KINDS:
+        node = cfg.get(group)
+        if group == "reward":
+            if node is not None:
+                cfg[group] = _typed_reward(node, by_group.pop(group, ()))
+            continue
+        cls, schema = _plugin_schema(group, node)
+        if cls is not None:
+            schemas.update(getattr(cls, "group_schemas", {}) or {})
+        if schema is not None:
+            where = f"{group}={node['name']}"
+            cfg[group] = typed_node(where, schema, node, by_group.pop(group, ()))
+            checks.append((where, schema, group))
+    schemas.update({g: _load_class(ref) for g, ref in CORE_GROUPS.items()})
+    for group, schema in schemas.items():
+        allowed.add(group)
+        if group in cfg:
+            cfg[group] = typed_node(group, schema, cfg.get(group), by_group.pop(group, ()))
+            checks.append((group, schema, group))
+    for where, schema, group in checks:  # attached to the root now: ${store} etc. resolve
+        check_node(where, schema, cfg[group])
+    for group, items in by_group.items():  # groups without a schema: plain struct updates
+        node = cfg.get(group)
+        if node is None or not OmegaConf.is_dict(node):
+            hint = f"choose one first: {group}=<{', '.join(plugins.names(group))}>" if group in plugins.KINDS \
+                else "no such group"
+            raise JtError(f"{group}.{items[0][0]}: no {group} is selected ({hint})")
+        OmegaConf.set_struct(node, True)
+        for key, value in items:
+            try:
+                OmegaConf.update(node, key, value, merge=True)
+            except Exception as e:  # noqa: BLE001
+                raise JtError(f"unknown key '{group}.{key}'") from e
+    allowed |= {k for k in cfg if OmegaConf.is_dict(cfg.get(k))}
+    unknown = sorted(k for k in cfg if k not in allowed)
+    if unknown:
+        raise JtError(f"unknown top-level key(s) {', '.join(unknown)}; top-level keys: "
+                      f"{', '.join(f.name for f in dataclasses.fields(RunConfig))} and the groups")
+    top = {k: cfg[k] for k in (f.name for f in dataclasses.fields(RunConfig)) if k in cfg}
+    try:
+        OmegaConf.merge(OmegaConf.structured(RunConfig), top)
+    except Exception as e:  # noqa: BLE001
+        raise _schema_error("config", RunConfig, e) from e
+    OmegaConf.set_struct(cfg, True)
+    return cfg
+
+
+def config_of(config_cls: type, cfg: Any, what: str = "config") -> Any:
+    """A typed ``Config`` dataclass instance from ``None``, an instance, a dataclass, a dict or a
+    group node — the one way every plugin parses its parameters.
+
+    Values are type-checked and converted through OmegaConf's structured configs (``"0.7"`` is
+    rejected for a float, ``1`` becomes ``1.0``); a ``check()`` method of ``config_cls`` runs on
+    the result. A ``name`` key is dropped unless ``config_cls`` declares it.
+
+    Args:
+        config_cls: the plugin's ``Config`` dataclass.
+        cfg: its parameters.
+        what: how to name the plugin in an error (``reward term safety``).
+
+    Raises:
+        JtError: an unknown key (the message lists the valid ones), a wrong type, a bad value.
+    """
+    if cfg is None:
+        obj = config_cls()
+    elif isinstance(cfg, config_cls):
+        obj = cfg
+    else:
+        obj = _to_object(config_cls, cfg, what)
+    check = getattr(obj, "check", None)
+    if callable(check):
+        check()
+    return obj
+
+
+def _to_object(config_cls: type, cfg: Any, what: str) -> Any:
+    from omegaconf import OmegaConf
+
+    if dataclasses.is_dataclass(cfg):
+        params = dataclasses.asdict(cfg)
+    elif isinstance(cfg, dict):
+        params = dict(cfg)
+    else:
+        params = OmegaConf.to_container(cfg, resolve=True)
+    known = {f.name for f in dataclasses.fields(config_cls)}
+    if "name" not in known:
+        params.pop("name", None)
+    unknown = sorted(set(params) - known)
+    if unknown:
+        valid = ", ".join(sorted(known - {"name"}))
+        raise JtError(f"{what}: unknown key(s) {', '.join(unknown)} (valid keys: {valid})")
+    try:
+        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(config_cls), params))
+    except Exception as e:  # noqa: BLE001 - OmegaConf raises several validation types
+        key = getattr(e, "full_key", None)
+        raise JtError(f"{what}: {key + ': ' if key else ''}{_first_line(e)}") from e
+
+
+def require(ok: bool, where: str, value: Any, rule: str) -> None:
+    """Raise ``JtError("{where}={value}: {rule}")`` unless ``ok`` — for ``Config.check()``."""
+    if not ok:
+        raise JtError(f"{where}={value}: {rule}")
+
+
+def finite(x: Any) -> bool:
+    """True for a finite number (``None`` and NaN/inf are not)."""
+    try:
+        return x is not None and math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False
