@@ -25,8 +25,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from jt_bullet import watch as watcher
 from jt_bullet.config import DEFAULT_CAMERA, CharacterConfig, SimConfig, typed
+from jt_bullet.queries import SceneQueries
 from toolkit.interfaces import Simulator
+from toolkit.interfaces.simulator import Watch
 
 
 def _get(cfg: Any, key: str) -> Any:
@@ -37,10 +40,11 @@ def _get(cfg: Any, key: str) -> Any:
     return cfg.get(key) if hasattr(cfg, "get") else getattr(cfg, key, None)
 
 
-class BulletSimulator(Simulator):
+class BulletSimulator(SceneQueries, Simulator):
     """PyBullet world (y-up, ground) with one character driven by an SPD backend per substep."""
 
     Config: ClassVar[type] = SimConfig
+    group_schemas: ClassVar[dict[str, type]] = {"character": CharacterConfig}
 
     def __init__(self, cfg: Any) -> None:
         import pybullet as pb
@@ -71,7 +75,7 @@ class BulletSimulator(Simulator):
             raise JtError(f"spd={spd_name} cannot drive a root servo (PyBullet's STABLE_PD leaves "
                           "the root unactuated); use spd=maba/df/sf/pcg or sim.root_servo.kp=0")
 
-        self.client, self.ground_id = scene.connect(self.dt, p.gravity, p.ground, p.friction,
+        self.client, self.ground = scene.connect(self.dt, p.gravity, p.ground, p.friction,
                                                     p.solver_iterations)
         self._kw = {"physicsClientId": self.client}
         self._pb = pb
@@ -88,6 +92,8 @@ class BulletSimulator(Simulator):
         self.io = BulletBody(self.client, body, self.model)
         self.backend.bind(self.io if self.steps_itself else self.model)
         self.n_links = pb.getNumJoints(body, **self._kw)
+        self._masses = np.array([pb.getDynamicsInfo(body, i, **self._kw)[0] for i in range(-1, self.n_links)])
+        self._link_ids = list(range(self.n_links))
 
         self.kp = np.array(self.character.kp, dtype=float)
         self.kd = np.array(self.character.kd, dtype=float)
@@ -121,8 +127,14 @@ class BulletSimulator(Simulator):
 
         Returns:
             A ``jt_bullet.characters.Character`` (``kp``, ``kd``, ``torque_limit`` overridden).
+
+        Raises:
+            UnknownName: ``joint_kp`` / ``joint_kd`` / ``joint_torque_limit`` names a joint the
+                character has not (a one-line ``JtError``, also a ``KeyError``; it lists the
+                movable joints).
         """
         from jt_bullet import characters, scene
+        from jt_bullet.queries import UnknownName
 
         cc = CharacterConfig.from_node(name)
         ch = characters.load(cc.name, client, **kw)
@@ -142,8 +154,8 @@ class BulletSimulator(Simulator):
                            (ch.torque_limit, cc.joint_torque_limit)):
             for joint, value in table.items():
                 if joint not in slices:
-                    raise KeyError(f"character {cc.name!r} has no movable joint {joint!r}; "
-                                   f"joints: {', '.join(slices)}")
+                    raise UnknownName(f"character {cc.name!r} has no movable joint {joint!r}; "
+                                      f"joints: {', '.join(slices)}")
                 arr[slices[joint]] = float(value)
         ch.gains_source += " (overridden by the character config)"
         return ch
@@ -163,36 +175,50 @@ class BulletSimulator(Simulator):
         q, qd = self.io.read()
         return q.copy(), qd.copy()
 
-    def step(self, q_target: np.ndarray, qd_target: np.ndarray | None = None) -> dict[str, Any]:
-        """One control step: ``n_substeps`` SPD-controlled substeps towards ``q_target``.
+    def step(self, q_target: np.ndarray, qd_target: np.ndarray | None = None,
+             n_substeps: int | None = None, watch: Watch | None = None) -> dict[str, Any]:
+        """One control step: ``n_substeps`` (default ``self.n_substeps``) SPD-controlled substeps
+        towards ``q_target``, ``watch``'s rules checked inside the loop.
+
+        Every substep reads the state, solves SPD, clips and applies the torques and steps
+        PyBullet, then checks the new state for NaN / explosion (a failure stops the loop); every
+        ``watch.check_every``-th substep (and the last) evaluates ``watch`` (``jt_bullet.watch``).
 
         Args:
             q_target: target positions ``(n_q,)``; the root part is read only with a root servo.
             qd_target: target velocities ``(n_dof,)``; zero if None.
+            n_substeps: substeps of this control step (e.g. fewer at the end of an episode).
+            watch: the termination rules and records of the episode (``toolkit.interfaces.Watch``).
 
         Returns:
             The step record: ``time`` (s), ``q`` ``(n_q,)``, ``qd`` ``(n_dof,)``, ``tau``
-            ``(n_dof,)`` (last applied, clipped; NaN for ``spd=bullet``), ``contacts`` (bool
-            ``(n_links + 1,)``, index = PyBullet link + 1), ``n_contacts``, ``failed``, ``reason``.
+            ``(n_dof,)`` (last applied, clipped; NaN for ``spd=bullet``), ``failed``, ``reason``,
+            ``substeps`` (simulated), ``outcome`` (``""``, ``"fail"``, ``"success"``,
+            ``"truncate"``), ``touched`` ``{body: links}``, ``samples`` ``{name: (k, ...)}`` and,
+            with ``sim.contacts``, ``contacts`` (bool ``(n_links + 1,)``, index = link + 1) and
+            ``n_contacts``.
         """
         if self.failed:
-            return dict(self._last, failed=True, reason=self.reason)
+            return dict(self._last, failed=True, reason=self.reason, substeps=0, outcome="fail",
+                        touched={}, samples=watcher.empty_samples(watch))
         pb, kw, io, be = self._pb, self._kw, self.io, self.backend
         qt = np.ascontiguousarray(q_target, dtype=float)
         if qt.shape != (self.model.n_q,):
             raise ValueError(f"q_target has shape {qt.shape}, expected ({self.model.n_q},)")
         vt = None if qd_target is None else np.ascontiguousarray(qd_target, dtype=float)
+        n = self.n_substeps if n_substeps is None else int(n_substeps)
         kp, kd, lim, dt, tau = self.kp, self.kd, self.torque_limit, self.dt, self._tau
+        check = watcher.Checker(self, watch, n)
         perf = time.perf_counter
         spd_s = sub_s = 0.0
         done = 0
-        for _ in range(self.n_substeps):
+        q, qd = io.read()
+        for k in range(n):
             t0 = perf()
             if self.steps_itself:
                 be.apply(qt, kp, kd, lim, vt)
                 ts = 0.0
             else:
-                q, qd = io.read()
                 t1 = perf()
                 raw = be.torques(q, qd, qt, kp, kd, dt, vt)
                 ts = perf() - t1
@@ -202,41 +228,30 @@ class BulletSimulator(Simulator):
                     break
                 io.write_torques(tau)
             pb.stepSimulation(**kw)
+            q, qd = io.read()
             dt_sub = perf() - t0
             sub_s += dt_sub
             spd_s += ts
             done += 1
+            self.time += dt
             if self.step_log is not None:
                 self.step_log.append((ts, dt_sub))
+            self._check(q, qd)
+            if self.failed or check.after_substep(k):
+                break
         self.timers["spd_s"] += spd_s
         self.timers["substep_s"] += sub_s
         self.timers["substeps"] += done
-        self.time += done * dt
-        q, qd = io.read()
-        if not self.failed:
-            self._check(q, qd)
         rec = {"time": self.time, "q": q.copy(), "qd": qd.copy(),
                "tau": np.full(self.model.n_v, np.nan) if self.steps_itself else tau.copy()}
         if self.params.contacts:
-            touching, n = self._contacts()
+            touching, n_pts = self._contacts()
         else:
-            touching, n = np.zeros(self.n_links + 1, dtype=bool), 0
-        rec.update(contacts=touching, n_contacts=n, failed=self.failed, reason=self.reason)
+            touching, n_pts = np.zeros(self.n_links + 1, dtype=bool), 0
+        rec.update(contacts=touching, n_contacts=n_pts, failed=self.failed, substeps=done,
+                   **check.result(self.failed, self.reason))
         self._last = rec
         return rec
-
-    def render(self, width: int = 320, height: int = 240) -> np.ndarray:
-        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, the camera on the root."""
-        from toolkit.render import Camera, render_frame
-
-        d, yaw, pitch = DEFAULT_CAMERA.get(self.char_cfg.name, (3.0, 0.0, -10.0))
-        c = self.char_cfg
-        cam = Camera(distance=d if c.camera_distance is None else c.camera_distance,
-                     yaw=yaw if c.camera_yaw is None else c.camera_yaw,
-                     pitch=pitch if c.camera_pitch is None else c.camera_pitch)
-        pos, _ = self._pb.getBasePositionAndOrientation(self.character.body_id, **self._kw)
-        target = [v if math.isfinite(v) else 0.0 for v in pos]
-        return render_frame(self.client, target, width, height, cam)
 
     def close(self) -> None:
         """Disconnect the PyBullet client (idempotent)."""
@@ -264,17 +279,6 @@ class BulletSimulator(Simulator):
     def reset_timers(self) -> None:
         """Zero the SPD / substep timers."""
         self.timers = {"spd_s": 0.0, "substep_s": 0.0, "substeps": 0}
-
-    def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
-        """World position ``(3,)`` and orientation x,y,z,w ``(4,)`` of a link's URDF frame
-        (-1: the base frame)."""
-        pb, b, kw = self._pb, self.character.body_id, self._kw
-        if link < 0:
-            pos, orn = pb.getBasePositionAndOrientation(b, **kw)
-        else:
-            s = pb.getLinkState(b, link, computeForwardKinematics=True, **kw)
-            pos, orn = s[4], s[5]
-        return np.array(pos), np.array(orn)
 
     def _check(self, q: np.ndarray, qd: np.ndarray) -> None:
         p = self.params

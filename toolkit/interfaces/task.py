@@ -70,12 +70,15 @@ class Task(Plugin, abc.ABC):
 
     Attributes:
         key_metrics: the metrics ``jt compare`` tabulates (mean ± std over seeds).
+        timing_metrics: metrics that measure wall time (frames per second, time shares): they
+            differ between runs by nature and are left out of same-seed checks.
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
     """
 
     key_metrics: ClassVar[tuple[str, ...]] = ()
+    timing_metrics: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg

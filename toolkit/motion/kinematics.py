@@ -166,3 +166,54 @@ def forward_kinematics(
                 org[i, k] = st[4]
                 ori[i, k] = st[5]
     return Kinematics(tuple(skeleton.links), com, org, ori)
+
+
+class KinematicBody:
+    """A kinematic copy of a skeleton's character in a private PyBullet DIRECT client (never
+    stepped): forward kinematics of poses for references and rewards.
+
+    Args:
+        skeleton: the character's skeleton (URDF, scale, joint layout).
+
+    Attributes:
+        masses: link masses ``(n_links + 1,)``, base first (kg).
+    """
+
+    def __init__(self, skeleton: Skeleton) -> None:
+        import pybullet as pb
+
+        self._pb = pb
+        self._stack = contextlib.ExitStack()
+        self.client, self.body = self._stack.enter_context(bullet_character(skeleton))
+        kw = {"physicsClientId": self.client}
+        n = pb.getNumJoints(self.body, **kw)
+        self.masses = np.array([pb.getDynamicsInfo(self.body, i, **kw)[0] for i in range(-1, n)])
+        self._indices = [j.bullet_index for j in skeleton.joints]
+        self._slices = list(skeleton.q_slices.values())
+
+    def pose(self, q: np.ndarray) -> None:
+        """Put the copy in pose ``q`` ``(n_q,)`` (``toolkit.dynamics`` layout)."""
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        q = np.asarray(q, dtype=float)
+        pb.resetBasePositionAndOrientation(self.body, q[:3].tolist(), q[3:7].tolist(), **kw)
+        pb.resetJointStatesMultiDof(self.body, self._indices, [q[7:][s].tolist() for s in self._slices], **kw)
+
+    def lowest_point(self, q: np.ndarray, link: int | None = None) -> float:
+        """Lowest height of a link's bounding box (None: of the whole body) in pose ``q``."""
+        self.pose(q)
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        links = [link] if link is not None else range(-1, len(self.masses) - 1)
+        return float(min(pb.getAABB(self.body, i, **kw)[0][1] for i in links))
+
+    def links_and_com(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)`` of pose ``q``."""
+        q = np.asarray(q, dtype=float)
+        self.pose(q)
+        pb, kw = self._pb, {"physicsClientId": self.client}
+        states = pb.getLinkStates(self.body, list(range(len(self.masses) - 1)), computeForwardKinematics=True, **kw)
+        links = np.array([q[:3]] + [s[0] for s in states], dtype=float)
+        return links, self.masses @ links / self.masses.sum()
+
+    def close(self) -> None:
+        """Disconnect the private client (idempotent)."""
+        self._stack.close()

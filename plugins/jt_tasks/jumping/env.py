@@ -1,8 +1,9 @@
 """The jump environment (``gymnasium.Env``): from a take-off state over a bar / obstacle onto a mat.
 
 One episode (``000`` §6.1): reset to the take-off state (``takeoff``) in front of the suite
-(``scene``); each ``step`` maps the action to PD targets (the action space plugin), then runs
-``round(sim_hz / control_hz)`` simulation substeps, checking contacts after each:
+(``scene``); each ``step`` maps the action to PD targets (the action space plugin), then the
+simulator runs ``round(sim_hz / control_hz)`` substeps, checking the episode's rules
+(``Watch``) after each:
 
 * failure (terminated, reward = product of the terms = 0 through ``task_complete``): any body part
   touches the wall / obstacle, any part other than the take-off foot touches the ground, the
@@ -34,12 +35,12 @@ import math
 from typing import Any, Optional
 
 import numpy as np
-import gymnasium
-from gymnasium import spaces
 
 from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
+from jt_tasks.policy.env import CharacterEnv
 from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
+from toolkit.interfaces.simulator import ContactRule, Watch
 
 HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index)
 
@@ -67,26 +68,22 @@ class EnvSpec:
     policy_features: list = dataclasses.field(default_factory=list)  # Stage 2: f_i of earlier policies
 
 
-class JumpEnv(gymnasium.Env):
+class JumpEnv(CharacterEnv):
     """High / obstacle / long jump from a take-off state (000 §6.1), sparse product reward."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    #: looks at the root from the run-up side, a little above: the mat and the bar wall, which
+    #: stand beyond the athlete from there, never hide it (the simulator's default side view does)
+    CAMERA = {"distance": 4.0, "yaw": 180.0, "pitch": -20.0}
 
-    def __init__(self, spec: EnvSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
-        import pybullet as pb
-
-        from jt_tasks.character_env import setup_character
+    # ------------------------------------------------------------------ set-up (scene, initial state)
+    def setup(self) -> None:
         from toolkit import plugins
 
-        super().__init__()
-        self.spec_ = spec
-        self.render_mode = render_mode
-        self._pb = pb
-        setup_character(self, spec.sim, spec.action)
+        spec = self.spec_
         self.foot_link = FOOT_LINKS[spec.foot]
         self.terms = {name: plugins.load("reward", name)(params)
                       for name, params in (spec.reward_terms or {}).items()}
-        self.suite = Suite(self.client, spec.suite)
+        self.suite = Suite(self.sim, spec.suite)
         feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
         if spec.takeoff_file:
             from jt_tasks.takeoff import source as takeoff_source
@@ -99,10 +96,20 @@ class JumpEnv(gymnasium.Env):
         self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)
         self.tracker = CrossingTracker()
         self._reset_episode()
-        obs = self._obs()
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
-        if seed is not None:
-            self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
+
+    def _rules(self) -> Watch:
+        """Ends a jump: the wall / obstacle touched, the ground touched by anything but the take-off
+        foot, a landing on the mat clear of the wall (success), the time limit; the first touch of
+        the mat is noted (head-first landing), CoM and root are recorded for the crossing."""
+        spec, suite = self.spec_, self.suite
+        rules = []
+        if suite.barrier_id >= 0:
+            rules.append(ContactRule(suite.barrier_id, "fail", "touched the bar"))
+        rules += [ContactRule(self.sim.ground, "fail", "touched the ground", except_links=(self.foot_link,)),
+                  ContactRule(suite.mat_id, "success", "success", clear_of=suite.barrier_id,
+                              margin=spec.safe_margin)]
+        return Watch(rules=tuple(rules), touches=(suite.mat_id,), record=("time", "com", "root"),
+                     time_limit=spec.time_limit, check_every=spec.check_every)
 
     # ------------------------------------------------------------------ curriculum attributes
     @property
@@ -135,6 +142,9 @@ class JumpEnv(gymnasium.Env):
         """Simulation substeps per control step: ``round(sim_hz / control_hz)`` (at least 1)."""
         return max(1, int(round(self.sim_hz / float(self.control_hz))))
 
+    def substeps_now(self) -> int:
+        return self.substeps
+
     @property
     def difficulty(self) -> float:
         """The curriculum's z: bar height (high jump) or obstacle width."""
@@ -144,20 +154,16 @@ class JumpEnv(gymnasium.Env):
     # ------------------------------------------------------------------ helpers
     def _place(self, q: np.ndarray, qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Lift/lower the state so that the take-off foot is ``foot_clearance`` above the ground."""
-        pb, kw = self._pb, {"physicsClientId": self.client}
         q = q.copy()
         self.sim.reset(q, qd)
-        foot_min = pb.getAABB(self.body, self.foot_link, **kw)[0][1]
+        foot_min = self.sim.aabb(self.foot_link)[0][1]
         q[1] += self.spec_.foot_clearance - foot_min
         return q, qd.copy()
 
     def _com_and_links(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        pos, orn = pb.getBasePositionAndOrientation(self.body, **kw)
-        states = pb.getLinkStates(self.body, list(range(self.n_links)), **kw)
-        links = np.array([pos] + [s[0] for s in states])
-        com = self.masses @ links / self.masses.sum()
-        return com, links, np.array(orn)
+        pos, orn = self.sim.link_states()
+        com = self.masses @ pos / self.masses.sum()
+        return com, pos, orn[0]
 
     def _reset_episode(self) -> None:
         spec = self.suite.spec
@@ -165,11 +171,11 @@ class JumpEnv(gymnasium.Env):
             self.suite.update(bar_height=self._pending["bar_height"])
         else:
             self.suite.update(obstacle_width=self._pending["obstacle_width"])
+        self.watch = self._rules()
         self.sim.reset(self._q0, self._qd0)
         self.action_space_.reset(None)
         self.tracker.reset()
         self.t = 0.0
-        self.done = False
         self._ang_speeds: list[float] = []
         self._penalties: list[float] = []
         self.landed = False
@@ -177,7 +183,7 @@ class JumpEnv(gymnasium.Env):
         com, _, orn = self._com_and_links()
         self.tracker.update(0.0, float(self.suite.past(com)), orn)
 
-    def _obs(self) -> np.ndarray:
+    def observe(self) -> np.ndarray:
         q, qd = self.sim.state()
         com, links, orn = self._com_and_links()
         R = self.suite.rotation()
@@ -193,68 +199,28 @@ class JumpEnv(gymnasium.Env):
         ]
         return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
 
-    def _contacts(self) -> tuple[bool, bool, set[int]]:
-        """``(wall touched, forbidden ground contact, links touching the mat)``."""
-        pts = self._pb.getContactPoints(bodyA=self.body, physicsClientId=self.client)
-        wall = ground = False
-        mat: set[int] = set()
-        for p in pts:
-            other, link = p[2], p[3]
-            if other == self.suite.barrier_id:
-                wall = True
-            elif other == self.ground and link != self.foot_link:
-                ground = True
-            elif other == self.suite.mat_id:
-                mat.add(int(link))
-        return wall, ground, mat
-
-    # ------------------------------------------------------------------ gymnasium API
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None) -> tuple[np.ndarray, dict]:
-        super().reset(seed=seed)
+    # ------------------------------------------------------------------ episode
+    def start(self, options: Optional[dict]) -> dict:
         self._reset_episode()
-        return self._obs(), {}
+        return {}
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:
-        if self.done:
-            raise RuntimeError("step() after the episode ended; call reset()")
-        targets = self.action_space_.targets(np.asarray(action, dtype=np.float64))
-        self._penalties.append(float(self.action_space_.penalty()))
-        q, _ = self.sim.state()
-        q_target = np.concatenate([q[:7], self.skeleton.dofs_to_joints(targets)])
-        status, reason = "", ""
-        for k in range(self.substeps):
-            rec = self.sim.step(q_target)
-            self.t = float(self.sim.time)
-            if rec["failed"]:
-                status, reason = "fail", f"simulator: {rec['reason']}"
-                break
-            if (k + 1) % self.spec_.check_every and k + 1 < self.substeps:
-                continue
-            com, _, orn = self._com_and_links()
-            self.tracker.update(self.t, float(self.suite.past(com)), orn)
-            wall, ground, mat = self._contacts()
-            if wall:
-                status, reason = "fail", "touched the bar"
-                break
-            if ground:
-                status, reason = "fail", "touched the ground"
-                break
-            if mat:
-                if not self.landed:
-                    self.landed, self.head_first = True, HEAD_LINK in mat
-                if not self.suite.near_barrier(self.body, self.spec_.safe_margin):
-                    status = "success"
-                    break
-            if self.t >= self.spec_.time_limit - 1e-9:
-                status, reason = "fail", "time limit"
-                break
+    def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        self._penalties.append(self.penalty)
+        self.t = float(rec["time"])
+        smp = rec["samples"]
+        for t, com, root in zip(smp["time"], smp["com"], smp["root"]):
+            self.tracker.update(float(t), float(self.suite.past(com)), root[3:7])
+        mat = rec["touched"].get(self.suite.mat_id)
+        if mat is not None and not self.landed:
+            self.landed, self.head_first = True, HEAD_LINK in mat
+        status, reason = rec["outcome"], rec["reason"]
+        if rec["failed"]:
+            reason = f"simulator: {reason}"
         _, qd = self.sim.state()
         self._ang_speeds.append(float(np.linalg.norm(qd[3:6])))
-        obs = self._obs()
         if not status:
-            return obs, 0.0, False, False, {}
-        self.done = True
-        return obs, *self._finish(status == "success", reason)
+            return 0.0, False, False, {}
+        return self._finish(status == "success", "" if status == "success" else reason)
 
     def _finish(self, success: bool, reason: str) -> tuple[float, bool, bool, dict]:
         record = self.episode_record(success)
@@ -282,28 +248,6 @@ class JumpEnv(gymnasium.Env):
             "policy_features": np.asarray(self.spec_.policy_features, dtype=float).reshape(-1, 4)
             if len(self.spec_.policy_features) else np.zeros((0, 4)),
         }
-
-    #: looks at the root from the run-up side, a little above: the mat and the bar wall, which
-    #: stand beyond the athlete from there, never hide it (the simulator's default side view does)
-    CAMERA = {"distance": 4.0, "yaw": 180.0, "pitch": -20.0}
-
-    def render(self) -> np.ndarray:
-        """RGB frame ``(240, 320, 3)`` uint8, the camera on the root."""
-        return self.render_frame(320, 240)
-
-    def render_frame(self, width: int, height: int) -> np.ndarray:
-        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, looking at the root."""
-        import pybullet as pb
-
-        from toolkit.render import Camera, render_frame
-
-        root = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)[0]
-        return render_frame(self.client, root, width, height, Camera(**self.CAMERA))
-
-    def close(self) -> None:
-        if getattr(self, "sim", None) is not None:
-            self.sim.close()
-            self.sim = None
 
 
 class EnvFactory:

@@ -1,6 +1,6 @@
 """The jumping suites (``000`` §6.1): a bar wall or an obstacle box, and a rigid landing mat.
 
-Built with PyBullet in the simulator's own client, in the take-off *facing frame* (the character
+Built as static boxes through the simulator interface (``Simulator.add_box``), in the take-off *facing frame* (the character
 at the origin heading +x, y up, +z its right; ``jt_tasks.takeoff.state``).
 
 High jump: "The crossbar is modeled as a rigid wall vertically extending from the ground to the
@@ -49,7 +49,7 @@ def _quat_from_columns(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[floa
 
 
 class Suite:
-    """The bodies of a suite in a PyBullet client, and its geometry.
+    """The bodies of a suite in a simulator's scene, and its geometry.
 
     Attributes:
         normal: horizontal unit normal of the bar / obstacle plane ``(3,)``, pointing away from
@@ -57,12 +57,16 @@ class Suite:
         along: horizontal unit vector along the bar ``(3,)`` (``normal × up``).
         plane: signed offset of the feature plane (bar plane, or the obstacle's centre plane):
             a point ``p`` is past it when ``normal · p > plane``.
-        barrier_id: body id of the wall / obstacle (-1: none).
-        mat_id: body id of the landing mat.
+        barrier_id: scene handle of the wall / obstacle (-1: none).
+        mat_id: scene handle of the landing mat.
+
+    Args:
+        sim: the simulator (``toolkit.interfaces.Simulator``) the suite stands in.
+        spec: its geometry.
     """
 
-    def __init__(self, client: int, spec: SuiteSpec) -> None:
-        self.client = client
+    def __init__(self, sim: Any, spec: SuiteSpec) -> None:
+        self.sim = sim
         self.spec = dataclasses.replace(spec)
         self.barrier_id = -1
         self.mat_id = -1
@@ -85,26 +89,16 @@ class Suite:
 
     def _box(self, centre_n: float, depth: float, height: float, length: float,
              rgba: tuple[float, ...]) -> int:
-        import pybullet as pb
-
-        kw = {"physicsClientId": self.client}
         half = [length / 2, height / 2, depth / 2]  # local x along the bar, y up, z along normal
         orn = _quat_from_columns(self.along, self.up, np.cross(self.along, self.up))
-        col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, **kw)
-        vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=list(rgba), **kw)
         pos = centre_n * self.normal + (height / 2) * self.up
-        body = pb.createMultiBody(0.0, col, vis, list(pos), orn, **kw)
-        pb.changeDynamics(body, -1, lateralFriction=0.9, **kw)
-        return body
+        return self.sim.add_box(half, list(pos), orn, rgba, friction=0.9)
 
     def build(self, spec: SuiteSpec) -> None:
         """(Re)create the bodies for ``spec``."""
-        import pybullet as pb
-
-        kw = {"physicsClientId": self.client}
         for b in (self.barrier_id, self.mat_id):
             if b >= 0:
-                pb.removeBody(b, **kw)
+                self.sim.remove(b)
         self.spec = dataclasses.replace(spec)
         self._frame(spec)
         self.barrier_id = -1
@@ -137,12 +131,6 @@ class Suite:
         """Suite frame axes as columns ``(3, 3)`` (right-handed: normal × up = along)."""
         return np.stack([self.normal, self.up, self.along], axis=1)
 
-    def near_barrier(self, body: int, margin: float) -> bool:
-        """True when any part of ``body`` is within ``margin`` of the wall / obstacle."""
-        import pybullet as pb
-
-        if self.barrier_id < 0:
-            return False
-        pts = pb.getClosestPoints(bodyA=body, bodyB=self.barrier_id, distance=float(margin),
-                                  physicsClientId=self.client)
-        return len(pts) > 0
+    def near_barrier(self, margin: float) -> bool:
+        """True when any part of the character is within ``margin`` of the wall / obstacle."""
+        return self.barrier_id >= 0 and self.sim.near(self.barrier_id, margin)

@@ -183,11 +183,10 @@ def resolve(params: Any, store_path: str, experiment: str, feature_names: tuple)
                       previous_runs=[r for r, _ in prev])
 
 
-def check_reward(terms: dict) -> None:
+def check_reward(terms: dict, task: str = "highjump") -> None:
     """Stage 2 needs the ``novelty`` term (eq 15); one-line error otherwise."""
     if "novelty" not in (terms or {}):
-        raise _err("task.stage=2: the reward has no 'novelty' term (000 eq 15); use reward=highjump_stage2 "
-                   "or leave the reward group unset")
+        raise _err(f"task.stage=2: the reward has no 'novelty' term (000 eq 15); add reward={task}_stage2")
 
 
 # ---------------------------------------------------------------------------- metrics

@@ -18,72 +18,116 @@ import math
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
-from toolkit.config import group_of, plain
-from toolkit.interfaces.plugin import Plugin
+import numpy as np
+
+from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
-from toolkit.interfaces.task import EvalContext, Evaluation, Task
+from toolkit.interfaces.task import EvalContext, Evaluation
+
+from jt_tasks.policy.task import PolicyTask
 
 FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
 
 
-def reward_terms_from_conf(name: str) -> dict:
-    """``terms`` of ``conf/reward/<name>.yaml`` (when the run config has no reward group)."""
-    from omegaconf import OmegaConf
-
-    from toolkit.config import conf_dir
-
-    return OmegaConf.to_container(OmegaConf.load(Path(conf_dir()) / "reward" / f"{name}.yaml"))["terms"]
-
-
 @dataclasses.dataclass
 class JumpConfig:
-    """Parameters shared by the jumping tasks (the ``task`` group)."""
+    """Parameters shared by the jumping tasks (the ``task`` group); the high jump's defaults.
+
+    The task's other choices are Hydra defaults of ``conf/task/<task>.yaml``: P-VAE actions
+    (000 §4.2), the product reward (000 eqs 2, 15, 16), the bar-height curriculum (000 §6.1.3) and
+    the dense SPD backend (ours: the same torques as MABA, faster for 34 DoF).
+    """
 
     name: str = "highjump"
-    stage: int = 1  # 1: take-off exploration (000 §5.1); 2: novel policy seeking (000 §5.2)
-    init: str = ""  # Stage 2: Stage-1 run id (outer run or nested evaluation), or its folder / ppo.h5
-    init_eval: int = -1  # Stage 2, outer init run: evaluation index to start from (-1: the best one)
-    policy_features: list = dataclasses.field(default_factory=list)  # Stage 2: f_i (x,y,z,w) of earlier policies
-    point: dict = dataclasses.field(default_factory=dict)  # fixed take-off features overriding the searched ones
-    ranges: dict = dataclasses.field(default_factory=dict)  # {feature: [low, high]} (see the task YAML)
-    takeoff: dict = dataclasses.field(default_factory=dict)  # {feature: default value} (the searched point's defaults)
-    takeoff_from: str = ""  # task=runup run id / folder / takeoff_state.h5 to start from (000 §6.1.1); "": the clip frame
-    distance: float = 0.9  # m, take-off point to the bar plane / obstacle (ours)
-    obstacle_height: float = 0.5  # m (000 §6.1); 0 for the long jump
-    mat_height: float = 0.3  # m, rigid landing block (ours)
-    clip: str = "run"  # reference run clip (000 §6.1.1)
-    foot: str = "right"  # take-off foot (ours: the outer foot of a Fosbury with the bar on the left)
-    omega_y: Optional[float] = 3.0  # rad/s, fixed facing-frame omega_y of the high jump (000 §6.1.1)
-    v_y: Optional[float] = 2.06  # m/s vertical root speed at take-off, the "jumping intention" of 000 §8
-    # (ours: humanoid3d_jump.txt's lift-off speed, takeoff.liftoff_vertical_speed); None: the run clip's
-    time_limit: float = 2.0  # s (000 §6.1)
-    safe_margin: float = 0.2  # m (000 §6.1)
-    check_every: int = 1  # substeps between contact checks (1 = every 600 Hz substep)
-    action: str = "pvae"  # action space when cfg.action is null (000 §4.2)
-    reward: str = "highjump"  # conf/reward/<this>.yaml when cfg.reward is null (000 eqs 2, 16)
-    curriculum: str = "bar_height"  # curriculum when cfg.curriculum is null (000 §6.1.3)
-    spd: str = "df"  # SPD backend when cfg.spd is null (ours: dense SPD, fastest for 34 DoF)
-    distinct_threshold: float = 0.5  # rad: Stage-1 features closer than this are one strategy (ours)
-    filmstrip_frames: int = 8  # frames of the final jump
-    filmstrip_width: int = 160  # px per frame
-    filmstrip_height: int = 120  # px
+    """Registry name."""
+    stage: int = 1
+    """1: take-off exploration (000 §5.1); 2: novel policy seeking (000 §5.2; with reward=<task>_stage2)."""
+    init: str = ""
+    """Stage 2: Stage-1 run id (outer run or nested evaluation), or its folder / ppo.h5 (000 §5.2)."""
+    init_eval: int = -1
+    """Stage 2, outer init run: evaluation index (jt.eval_index); -1: the best one (ours)."""
+    policy_features: list = dataclasses.field(default_factory=list)
+    """Stage 2: extra root orientations (x, y, z, w, suite frame) of earlier policies for Π (000 eq 12)."""
+    point: dict = dataclasses.field(default_factory=dict)
+    """Take-off features fixed here are not searched."""
+    ranges: dict = dataclasses.field(default_factory=lambda: {
+        "alpha": [-0.5, 2.5], "omega_x": [-3.0, 3.0], "omega_z": [-3.0, 3.0], "v_z": [-2.5, -0.5]})
+    """Search box ``{feature: [low, high]}``: ours, enclosing 000 Table 3 (the paper gives no ranges);
+    alpha (rad) turns the wall line x sin(a) - z cos(a) in the facing frame (000 App. A), omega_x,
+    omega_z (rad/s) in the facing frame (000 §6.1.1), v_z (m/s)."""
+    takeoff: dict = dataclasses.field(default_factory=lambda: dict(FOSBURY))
+    """Defaults of the searched features: the Fosbury flop take-off state (000 Table 3)."""
+    takeoff_from: str = ""
+    """A task=runup run id / folder / takeoff_state.h5 to start from (000 §6.1.1); "": the run
+    clip's take-off frame with the features imposed (docs/highjump.md)."""
+    distance: float = 0.9
+    """m from the take-off root to the bar plane / obstacle (ours)."""
+    obstacle_height: float = 0.5
+    """m, the obstacle jump's box (000 §6.1: 50 cm); unused by the high jump; 0: the long jump."""
+    mat_height: float = 0.3
+    """m, the rigid landing block (000 §6.1 gives no size; ours)."""
+    clip: str = "run"
+    """Reference run: pybullet_data humanoid3d_run.txt (000 §6.1.1 used a curved sprint)."""
+    foot: str = "right"
+    """Take-off foot (ours; the outer foot of a Fosbury flop with the bar on the left)."""
+    omega_y: Optional[float] = 3.0
+    """rad/s, the high jump's fixed facing-frame omega_y (000 §6.1.1); None: explored / kept."""
+    v_y: Optional[float] = 2.06
+    """m/s vertical root speed at take-off, the "jumping intention" of the authors' run-up (000 §8);
+    ours: humanoid3d_jump.txt's lift-off speed (DeepMimic's run has none); None: the run clip's."""
+    time_limit: float = 2.0
+    """s after take-off (000 §6.1)."""
+    safe_margin: float = 0.2
+    """m: a landing counts with every part this far from the wall (000 §6.1)."""
+    check_every: int = 1
+    """Substeps between contact checks (ours: every 600 Hz substep)."""
+    distinct_threshold: float = 0.5
+    """rad: Stage-1 features closer than this count as one strategy (ours)."""
+    filmstrip_frames: int = 8
+    """Frames of the final jump's filmstrip."""
+    filmstrip_width: int = 160
+    """px per filmstrip frame."""
+    filmstrip_height: int = 120
+    """px."""
+
+    def check(self) -> None:
+        """Range checks (one ``JtError`` line each)."""
+        from toolkit.schema import finite, require
+
+        require(self.stage in (1, 2), "task.stage", self.stage,
+                "1 (take-off exploration) or 2 (novel policy seeking)")
+        for key, (lo, hi) in {k: tuple(v) for k, v in (self.ranges or {}).items()}.items():
+            require(finite(lo) and finite(hi) and float(lo) < float(hi), f"task.ranges.{key}", [lo, hi],
+                    "needs finite [low, high] with low < high")
+        for key in ("distance", "time_limit", "distinct_threshold"):
+            require(finite(getattr(self, key)) and getattr(self, key) > 0, f"task.{key}", getattr(self, key),
+                    "must be a finite number > 0")
+        for key in ("obstacle_height", "mat_height", "safe_margin"):
+            require(finite(getattr(self, key)) and getattr(self, key) >= 0, f"task.{key}", getattr(self, key),
+                    "must be a finite number >= 0")
+        require(self.foot in ("left", "right"), "task.foot", self.foot, "left or right")
+        require(self.check_every >= 1, "task.check_every", self.check_every, "must be >= 1")
+        require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
+                "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,
+                                                       self.filmstrip_height), "frames >= 0, sizes > 0")
 
 
-class JumpTask(Task):
+class JumpTask(PolicyTask):
     """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
 
     key_metrics: ClassVar[tuple[str, ...]] = ("strategy_angle", "bar_height_reached", "success_rate")
     kind: ClassVar[str] = "highjump"
     feature_names: ClassVar[tuple[str, ...]] = ("alpha", "omega_x", "omega_z", "v_z")
     Config: ClassVar[type] = JumpConfig
-    RANGES: ClassVar[dict] = {}
-    DEFAULTS: ClassVar[dict] = {}
+    env_path: ClassVar[str] = "jt_tasks.jumping.env:JumpEnv"
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        group = group_of(cfg, "task")
-        params = Plugin.params_of(group) if group is not None else {}
-        self.params = self.Config(**params)
+        cfg = self.cfg
+        if self.params.stage == 2:
+            from jt_tasks.jumping.stage2 import check_reward
+
+            check_reward(plain(group_of(cfg, "reward")).get("terms", {}), self.params.name)
         self._stage2: Any = None
         self._takeoff_file: Optional[Path] = None
 
@@ -131,14 +175,13 @@ class JumpTask(Task):
 
     # ------------------------------------------------------------------ search problem
     def ranges(self) -> dict[str, tuple[float, float]]:
-        r = dict(self.RANGES)
-        r.update({k: (float(v[0]), float(v[1])) for k, v in (self.params.ranges or {}).items()})
-        return r
+        """The search box ``{feature: (low, high)}`` (``task.ranges``)."""
+        return {k: (float(v[0]), float(v[1])) for k, v in (self.params.ranges or {}).items()}
 
     def problem(self) -> SearchProblem:
         from jt_tasks.jumping.features import angle_distance
 
-        r, d = self.ranges(), {**self.DEFAULTS, **(self.params.takeoff or {})}
+        r, d = self.ranges(), dict(self.params.takeoff or {})
         if self.params.stage == 2:
             search = group_of(self.cfg, "search")
             if search is not None and str(group_of(search, "name")) != "single":
@@ -157,16 +200,13 @@ class JumpTask(Task):
         from jt_tasks.jumping.scene import SuiteSpec
 
         p, cfg = self.params, self.cfg
-        feats = {**self.DEFAULTS, **(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
+        feats = {**(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
                  **{k: float(v) for k, v in self._fixed().items()}}
         feats = {k: float(feats[k]) for k in self.feature_names}
         suite = SuiteSpec(kind=self.kind, alpha=feats.get("alpha", 0.0), distance=p.distance,
                           obstacle_height=p.obstacle_height, mat_height=p.mat_height)
-        sim = {"sim": plain(group_of(cfg, "sim")), "spd": plain(group_of(cfg, "spd")) or {"name": p.spd},
-               "character": plain(group_of(cfg, "character")) or {"name": "humanoid"}}
-        action = plain(group_of(cfg, "action")) or {"name": p.action}
-        reward = group_of(cfg, "reward")
-        terms = plain(reward)["terms"] if reward is not None else reward_terms_from_conf(self.reward_name())
+        sim, action = self.character_groups()
+        terms = plain(group_of(cfg, "reward")).get("terms", {})
         init = self.stage2_init()
         pol = init.policy_features if init is not None else (p.policy_features or [])
         return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
@@ -176,47 +216,57 @@ class JumpTask(Task):
                        sim=sim, action=action, reward_terms=terms,
                        policy_features=[list(map(float, f)) for f in pol])
 
-    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
-        """The ``JumpEnv`` of take-off features ``point`` (missing: the defaults), bar at ``z_min``."""
-        from jt_tasks.jumping.env import JumpEnv
-
-        return JumpEnv(self.env_spec(dict(point or {})), seed=seed)
-
-    def reward_name(self) -> str:
-        return self.params.reward + ("_stage2" if self.params.stage == 2 else "")
-
     def curriculum(self) -> Any:
+        """The curriculum plugin of the ``curriculum`` group (the task's YAML chooses one)."""
         from toolkit import plugins
+        from toolkit.errors import JtError
 
         node = group_of(self.cfg, "curriculum")
-        name = str(node.name) if node is not None else self.params.curriculum
-        return plugins.load("curriculum", name)(node)
+        if node is None:
+            raise JtError(f"task={self.params.name} needs a curriculum: curriculum=<{', '.join(plugins.names('curriculum'))}>")
+        return plugins.load("curriculum", str(node.name))(node)
 
-    # ------------------------------------------------------------------ evaluation
-    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
-        from jt_tasks.jumping.train import run_evaluation
+    # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
+    def training(self, spec: Any, ctx: EvalContext) -> Any:
+        from jt_tasks.jumping.train import curriculum_hooks
+        from jt_tasks.policy.train import agent_config
 
-        p = self.params
-        spec = self.env_spec(point)
         init = self.stage2_init()
-        if init is not None:
-            from jt_tasks.jumping.stage2 import check_reward
+        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
+        return curriculum_hooks(spec, self.curriculum(), total, ctx.progress,
+                                warm_start=init.checkpoint if init is not None else None)
 
-            check_reward(spec.reward_terms)
-        out = run_evaluation(spec, self.curriculum(), group_of(self.cfg, "agent"), Path(ctx.workdir),
-                             ctx.seed, group_of(self.cfg, "executor"), p.filmstrip_frames,
-                             (p.filmstrip_width, p.filmstrip_height), ctx.progress,
-                             warm_start=init.checkpoint if init is not None else None)
-        ro, res = out["rollout"], out["result"]
+    def final_env(self, env: Any, hooks: Any, trained: Any) -> None:
+        from jt_tasks.jumping.train import after_training
+
+        after_training(hooks, trained.result)
+        for k, v in hooks.state["cur"].env_attrs().items():  # the reached difficulty
+            setattr(env, k, v)
+
+    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
+        ro["feature_quat"] = env.tracker.stage2(env.suite.rotation())
+        ro["feature_angle"] = env.tracker.stage1()
+        data = {"feature_quat": np.asarray(ro["feature_quat"], dtype=float),
+                "feature_angle": np.array([ro["feature_angle"]])}
+        attrs = {"features": {k: float(v) for k, v in spec.features.items()}, "kind": spec.kind,
+                 "return": float(ro["return"]), "reason": str(ro["info"].get("reason", ""))}
+        return data, attrs
+
+    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
+        from jt_tasks.jumping.train import jump_curves
+        from jt_tasks.policy.train import last_finite, return_curve
+
+        res, init = trained.result, self.stage2_init()
+        succ = [r for _, _, r in hooks.state["z_hist"] if math.isfinite(r)]
         angle = float(ro["feature_angle"])
         metrics = {
-            "strategy_angle": angle, "bar_height_reached": float(out["z"]),
+            "strategy_angle": angle, "bar_height_reached": float(hooks.state["cur"].z),
             "mean_return": float(ro["return"]),
-            "train_mean_return": _last(res.history.get("mean_return", [])),
-            "success_rate": out["succ"][-1] if out["succ"] else 0.0,
+            "train_mean_return": last_finite(res.history.get("mean_return", [])),
+            "success_rate": succ[-1] if succ else 0.0,
             "final_success": float(ro["info"].get("success", 0.0)),
             "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": out["samples_per_s"], "train_wall_s": float(out["wall_s"]),
+            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
         }
         metrics.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
         metrics.update({f"feature_q{i}": float(v) for i, v in enumerate(ro["feature_quat"])})
@@ -225,17 +275,11 @@ class JumpTask(Task):
 
             metrics.update(novelty_metrics(ro["feature_quat"], spec.policy_features, spec.reward_terms))
             metrics["init_eval_index"] = float(init.eval_index)
-        arts = ["ppo.h5", "rollout.h5"] + (["filmstrip.png"] if (Path(ctx.workdir) / "filmstrip.png").exists() else [])
+        history = {"mean_return": return_curve(trained), **jump_curves(hooks, res)}
         if not math.isfinite(angle):
             return Evaluation(metrics={k: v for k, v in metrics.items() if math.isfinite(v)}, failed=True,
-                              reason="the deterministic jump never crossed the bar plane",
-                              history=out["history"], artifacts=arts)
-        return Evaluation(metrics=metrics, features=[angle], history=out["history"], artifacts=arts)
-
-
-def _last(values: list) -> float:
-    finite = [float(v) for v in values if math.isfinite(float(v))]
-    return finite[-1] if finite else 0.0
+                              reason="the deterministic jump never crossed the bar plane", history=history)
+        return Evaluation(metrics=metrics, features=[angle], history=history)
 
 
 class HighJumpTask(JumpTask):
@@ -243,8 +287,6 @@ class HighJumpTask(JumpTask):
 
     kind = "highjump"
     feature_names = ("alpha", "omega_x", "omega_z", "v_z")
-    RANGES = {"alpha": (-0.5, 2.5), "omega_x": (-3.0, 3.0), "omega_z": (-3.0, 3.0), "v_z": (-2.5, -0.5)}
-    DEFAULTS = dict(FOSBURY)
 
 
 @dataclasses.dataclass
@@ -252,8 +294,15 @@ class ObstacleConfig(JumpConfig):
     """The obstacle jump's group (000 §6.1): the obstacle_width curriculum and reward."""
 
     name: str = "obstacle"
-    reward: str = "obstacle"  # conf/reward/obstacle.yaml (000 §6.1.2)
-    curriculum: str = "obstacle_width"  # (000 §6.1.3, Table 1)
+    """Registry name."""
+    ranges: dict = dataclasses.field(default_factory=lambda: {
+        "omega_x": [-3.0, 3.0], "omega_y": [-3.0, 3.0], "omega_z": [-3.0, 4.0]})
+    """Search box of the take-off root angular velocity (rad/s, facing frame, 000 §6.1.1): ours,
+    enclosing 000 Table 4."""
+    takeoff: dict = dataclasses.field(default_factory=lambda: {"omega_x": 0.0, "omega_y": 0.0, "omega_z": 1.0})
+    """Defaults of the searched features: the Straddle take-off state (000 Table 4)."""
+    omega_y: Optional[float] = None
+    """Explored by the obstacle jump (000 §6.1.1), so not fixed."""
 
 
 class ObstacleTask(JumpTask):
@@ -262,8 +311,6 @@ class ObstacleTask(JumpTask):
     kind = "obstacle"
     feature_names = ("omega_x", "omega_y", "omega_z")
     Config = ObstacleConfig
-    RANGES = {"omega_x": (-3.0, 3.0), "omega_y": (-3.0, 3.0), "omega_z": (-3.0, 4.0)}
-    DEFAULTS = {"omega_x": 0.0, "omega_y": 0.0, "omega_z": 1.0}  # 000 Table 4, Straddle
 
 
 @dataclasses.dataclass
@@ -271,7 +318,9 @@ class LongJumpConfig(ObstacleConfig):
     """The long jump's group: an obstacle jump over an obstacle of height 0 (a gap before the mat)."""
 
     name: str = "longjump"
-    obstacle_height: float = 0.0  # no box: jump the width onto the mat (jt variation)
+    """Registry name."""
+    obstacle_height: float = 0.0
+    """No box: jump the width onto the mat (jt variation)."""
 
 
 class LongJumpTask(ObstacleTask):

@@ -33,12 +33,12 @@ import math
 from typing import Any, Optional
 
 import numpy as np
-import gymnasium
-from gymnasium import spaces
 
 from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat
 from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
+from jt_tasks.policy.env import CharacterEnv
+from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 
 
@@ -63,31 +63,20 @@ class RunupSpec:
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
 
 
-class RunupEnv(gymnasium.Env):
+class RunupEnv(CharacterEnv):
     """DeepMimic run-up (000 §6.1.1): imitate the run, end at take-off with the target features."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
-
-    def __init__(self, spec: RunupSpec, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
-        import pybullet as pb
-
-        from jt_tasks.character_env import setup_character
-
-        super().__init__()
-        self.spec_ = spec
-        self.render_mode = render_mode
-        self._pb = pb
+    def setup(self) -> None:
+        spec = self.spec_
         self.targets = rw.goal_targets(spec.kind, spec.target, spec.omega_y)
-        setup_character(self, spec.sim, spec.action)
         self.control_hz = float(spec.control_hz)
         self.substeps = max(1, int(round(self.sim_hz / self.control_hz)))
         self.feet = {FOOT_LINKS["right"], FOOT_LINKS["left"]}
         self.ref = RunReference(spec.clip, spec.foot, spec.contact_tol, spec.foot_clearance, self.sim_hz)
-        if seed is not None:
-            self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
+        # DeepMimic's early termination: a body part other than the feet touches the ground
+        self.watch = Watch(rules=(ContactRule(self.sim.ground, "fail", "fell", except_links=tuple(sorted(self.feet))),),
+                           check_every=spec.check_every)
         self._start(self.ref.t_mid)
-        obs = self._obs()
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
 
     # ------------------------------------------------------------------ episode bookkeeping
     def _start(self, t0: float) -> None:
@@ -105,7 +94,6 @@ class RunupEnv(gymnasium.Env):
             q[1] += lift
         self.sim.reset(q, qd)
         self.action_space_.reset(None)
-        self.done = False
         self.terms_log: list[dict[str, float]] = []
 
     @property
@@ -118,15 +106,7 @@ class RunupEnv(gymnasium.Env):
         """Reference clip time of the current state (s)."""
         return (self.j0 + self.substeps_done) / self.sim_hz
 
-    def links_and_com(self) -> tuple[np.ndarray, np.ndarray]:
-        """Simulated link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)``."""
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        pos, _ = pb.getBasePositionAndOrientation(self.body, **kw)
-        states = pb.getLinkStates(self.body, list(range(self.n_links)), **kw)
-        links = np.array([pos] + [s[0] for s in states])
-        return links, self.masses @ links / self.masses.sum()
-
-    def _obs(self) -> np.ndarray:
+    def observe(self) -> np.ndarray:
         q, qd = self.sim.state()
         links, _ = self.links_and_com()
         hq = heading_quat(q[3:7])
@@ -139,11 +119,6 @@ class RunupEnv(gymnasium.Env):
                  q[7:], qd[6:], rel.reshape(-1), [math.sin(ph), math.cos(ph), left]]
         return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
 
-    def _fallen(self) -> bool:
-        """A body part other than the feet touches the ground (DeepMimic's early termination)."""
-        pts = self._pb.getContactPoints(bodyA=self.body, bodyB=self.ground, physicsClientId=self.client)
-        return any(int(p[3]) not in self.feet for p in pts)
-
     def imitation(self) -> dict[str, float]:
         """The imitation terms (``reward.imitation_terms``) of the current state vs the reference."""
         q, qd = self.sim.state()
@@ -153,50 +128,39 @@ class RunupEnv(gymnasium.Env):
         return rw.imitation_terms(self.skeleton, q, qd, facing_frame(q, links[ee]), com,
                                   ref.q, ref.qd, facing_frame(ref.q, ref.links[ee]), ref.com)
 
-    # ------------------------------------------------------------------ gymnasium API
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None) -> tuple[np.ndarray, dict]:
-        super().reset(seed=seed)
+    # ------------------------------------------------------------------ gymnasium hooks
+    def start(self, options: Optional[dict]) -> dict:
         if options and options.get("time") is not None:
             t0 = float(options["time"])
         else:
             t0 = float(self.np_random.uniform(0.0, self.ref.period))
         self._start(t0)
-        return self._obs(), {"start_time": self.t0, "takeoff_time": self.t_takeoff, "n_steps": self.n_steps}
+        return {"start_time": self.t0, "takeoff_time": self.t_takeoff, "n_steps": self.n_steps}
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:
-        if self.done:
-            raise RuntimeError("step() after the episode ended; call reset()")
-        targets = self.action_space_.targets(np.asarray(action, dtype=np.float64))
-        q, _ = self.sim.state()
-        q_target = np.concatenate([q[:7], self.skeleton.dofs_to_joints(targets)])
-        n = min(self.substeps, self.total_substeps - self.substeps_done)
+    def substeps_now(self) -> int:
+        return min(self.substeps, self.total_substeps - self.substeps_done)
+
+    def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        self.substeps_done += int(rec["substeps"])
         reason = ""
-        for k in range(n):
-            rec = self.sim.step(q_target)
-            self.substeps_done += 1
-            if rec["failed"]:
-                reason = f"simulator: {rec['reason']}"
-                break
-            if ((k + 1) % self.spec_.check_every == 0 or k + 1 == n) and self._fallen():
-                reason = "fell"
-                break
+        if rec["failed"]:
+            reason = f"simulator: {rec['reason']}"
+        elif rec["outcome"]:
+            reason = rec["reason"]
         if reason.startswith("simulator"):  # NaN / exploded state: nothing to compare
             terms = {k: 0.0 for k in ("pose", "vel", "ee", "com", "imitation")}
         else:
             terms = self.imitation()
         self.terms_log.append(terms)
         reward = self.spec_.w_imitation * terms["imitation"]
-        obs = self._obs()
         took_off = not reason and self.substeps_done >= self.total_substeps
         if not reason and not took_off:
-            return obs, float(reward), False, False, {}
-        self.done = True
+            return float(reward), False, False, {}
         info = self._final_info(took_off, reason)
         if took_off:
             k_goal = float(self.n_steps if self.spec_.goal_steps is None else self.spec_.goal_steps)
             reward += self.spec_.w_goal * k_goal * info["r_goal"]
-        obs = np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0)
-        return obs, float(reward), True, False, info
+        return float(reward), True, False, info
 
     def _final_info(self, took_off: bool, reason: str) -> dict[str, Any]:
         q, qd = self.sim.state()
@@ -216,21 +180,11 @@ class RunupEnv(gymnasium.Env):
         """The simulated ``(q, qd)`` now (world); call it when an episode ended at take-off."""
         return self.sim.state()
 
-    def render(self) -> np.ndarray:
-        """RGB frame ``(240, 320, 3)`` uint8, the camera on the root."""
-        return self.render_frame(320, 240)
-
-    def render_frame(self, width: int, height: int) -> np.ndarray:
-        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer (the simulator's side view)."""
-        return self.sim.render(width, height)
-
     def close(self) -> None:
         if getattr(self, "ref", None) is not None:
             self.ref.close()
             self.ref = None
-        if getattr(self, "sim", None) is not None:
-            self.sim.close()
-            self.sim = None
+        super().close()
 
 
 class EnvFactory:

@@ -7,8 +7,8 @@ the DeepMimic clip, as the jump tasks do) and answers what the run-up environmen
   jump tasks find it (``jt_tasks.takeoff.state.support_phase_time``), repeating once per cycle;
 * the reference state ``(q, qd)`` at any clip time (``jt_tasks.takeoff.state.reference_state``: slerp pose and
   central-difference velocities, the root shifted by the clip's cycle offset on every loop);
-* forward kinematics of a state (link centres of mass, whole-body CoM) by PyBullet, in a private
-  DIRECT client holding one kinematic copy of the humanoid (never stepped);
+* forward kinematics of a state (link centres of mass, whole-body CoM) by a kinematic copy of
+  the humanoid (``toolkit.motion.kinematics.KinematicBody``, never stepped);
 * ``at(j)``: all of the above at clip time ``j / sim_hz``, memoised per process (the environment
   keeps its clip times on the simulation grid, so an episode's reference is computed once and
   shared by every environment of a rollout worker).
@@ -20,7 +20,6 @@ take-off instant, as ``JumpEnv`` places its take-off state.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 import os
@@ -67,7 +66,7 @@ class RunReference:
     def __init__(self, clip_name: str = "run", foot: str = "right", contact_tol: float = 0.06,
                  foot_clearance: float = 0.002, sim_hz: float = 600.0) -> None:
         from toolkit.motion import load_clip
-        from toolkit.motion.kinematics import bullet_character
+        from toolkit.motion.kinematics import KinematicBody
         from toolkit.motion.skeletons import motions_dir
 
         path = clip_name if os.path.sep in clip_name else os.path.join(motions_dir(), f"humanoid3d_{clip_name}.txt")
@@ -80,16 +79,8 @@ class RunReference:
         self.foot = foot
         self.period = float(self.clip.duration)
         self.t_mid, _ = support_phase_time(self.clip, foot, contact_tol)
-        self._stack = contextlib.ExitStack()
-        self.client, self.body = self._stack.enter_context(bullet_character(self.skeleton))
-        import pybullet as pb
-
-        self._pb = pb
-        kw = {"physicsClientId": self.client}
-        n = pb.getNumJoints(self.body, **kw)
-        self.masses = np.array([pb.getDynamicsInfo(self.body, i, **kw)[0] for i in range(-1, n)])
-        self._indices = [j.bullet_index for j in self.skeleton.joints]
-        self._slices = list(self.skeleton.q_slices.values())
+        self.body = KinematicBody(self.skeleton)
+        self.masses = self.body.masses
         self.ground_offset = 0.0
         q, _ = self.state(self.t_mid)
         self.ground_offset = float(foot_clearance - self.lowest_point(q, FOOT_LINKS[foot]))
@@ -129,29 +120,17 @@ class RunReference:
         p = p + np.array([0.0, self.ground_offset, 0.0])
         return np.concatenate([p, r, j]), np.concatenate([v, w, jv])
 
-    def _pose(self, q: np.ndarray) -> None:
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        pb.resetBasePositionAndOrientation(self.body, q[:3].tolist(), q[3:7].tolist(), **kw)
-        pb.resetJointStatesMultiDof(self.body, self._indices, [q[7:][s].tolist() for s in self._slices], **kw)
-
     def lowest_point(self, q: np.ndarray, link: Optional[int] = None) -> float:
         """Lowest height of a link's bounding box (or of the whole body) in pose ``q``."""
-        self._pose(np.asarray(q, dtype=float))
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        links = [link] if link is not None else range(-1, len(self.masses) - 1)
-        return float(min(pb.getAABB(self.body, i, **kw)[0][1] for i in links))
+        return self.body.lowest_point(q, link)
 
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)`` of pose ``q``."""
-        self._pose(np.asarray(q, dtype=float))
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        states = pb.getLinkStates(self.body, list(range(len(self.masses) - 1)), computeForwardKinematics=True, **kw)
-        links = np.array([q[:3]] + [s[0] for s in states], dtype=float)
-        return links, self.masses @ links / self.masses.sum()
+        return self.body.links_and_com(q)
 
     def close(self) -> None:
-        """Disconnect the private PyBullet client (idempotent)."""
-        self._stack.close()
+        """Release the kinematic copy (idempotent)."""
+        self.body.close()
 
 
 def facing_frame(q: np.ndarray, points: np.ndarray) -> np.ndarray:

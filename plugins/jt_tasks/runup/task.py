@@ -18,29 +18,23 @@ import math
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
-from toolkit.config import group_of, plain, task_params
+import numpy as np
+
+from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
-from toolkit.interfaces.task import EvalContext, Evaluation, Task
+from toolkit.interfaces.task import EvalContext, Evaluation
+
+from jt_tasks.policy.task import PolicyTask
 
 
 def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
-    """``(ranges, defaults)`` of the take-off features of ``conf/task/<kind>.yaml`` (the jump task's
-    search box: ``000`` Tables 3 / 4), falling back to the jump task classes' constants."""
-    from jt_tasks.jumping.task import HighJumpTask, ObstacleTask
+    """``(ranges, defaults)`` of the take-off features of the jump task ``kind`` (its search box,
+    ``000`` Tables 3 / 4), from that task plugin's ``Config`` through the registry."""
+    from toolkit import plugins
 
-    cls = HighJumpTask if kind == "highjump" else ObstacleTask
-    ranges, defaults = dict(cls.RANGES), dict(cls.DEFAULTS)
-    try:
-        from omegaconf import OmegaConf
-
-        from toolkit.config import conf_dir
-
-        node = OmegaConf.to_container(OmegaConf.load(Path(conf_dir()) / "task" / f"{kind}.yaml"), resolve=True)
-        ranges.update({k: (float(v[0]), float(v[1])) for k, v in (node.get("ranges") or {}).items()})
-        defaults.update({k: float(v) for k, v in (node.get("takeoff") or {}).items()})
-    except Exception:  # noqa: BLE001 - no conf/ (an unusual install): the classes' values
-        pass
-    return ranges, defaults
+    c = plugins.load("task", kind).Config()
+    return ({k: (float(v[0]), float(v[1])) for k, v in c.ranges.items()},
+            {k: float(v) for k, v in c.takeoff.items()})
 
 
 @dataclasses.dataclass
@@ -48,38 +42,55 @@ class RunupConfig:
     """The ``task`` group of ``task=runup`` (conf/task/runup.yaml has each value's source)."""
 
     name: str = "runup"
-    kind: str = "highjump"  # highjump (000 eq 13) | obstacle (000 eq 14)
-    point: dict = dataclasses.field(default_factory=dict)  # target features fixed here are not searched
-    ranges: dict = dataclasses.field(default_factory=dict)  # {feature: [low, high]}; unset: conf/task/<kind>.yaml
-    target: dict = dataclasses.field(default_factory=dict)  # default targets; unset: conf/task/<kind>.yaml takeoff
-    omega_y: Optional[float] = 3.0  # rad/s, the high jump's fixed omega_y target (000 §6.1.1)
-    clip: str = "run"  # reference run (DeepMimic humanoid3d_run.txt; 000 used its own sprints)
-    foot: str = "right"  # take-off foot (as the jump tasks)
-    n_strides: int = 2  # take-off-foot mid-supports from the start to the take-off (ours)
-    contact_tol: float = 0.06  # m: support-phase detection (jumping/takeoff.py)
-    foot_clearance: float = 0.002  # m: take-off foot above the ground at take-off (jumping/env.py)
-    control_hz: float = 30.0  # policy rate (Peng et al. 2018)
-    check_every: int = 1  # substeps between early-termination contact checks
-    w_imitation: float = 0.7  # w_I (ours; 000 gives no weights)
-    w_goal: float = 0.3  # w_G (ours)
-    goal_steps: Optional[float] = None  # terminal multiplier of w_G r_G; null: the episode's control steps
-    eval_lead: Optional[float] = None  # s before a take-off mid-support the final rollout starts; None: n_strides cycles
-    action: str = "raw"  # action space when cfg.action is null (DeepMimic: PD targets)
-    spd: str = "df"  # SPD backend when cfg.spd is null
-    filmstrip_frames: int = 8  # frames of the final run-up
-    filmstrip_width: int = 160  # px per frame
-    filmstrip_height: int = 120  # px
+    kind: str = "highjump"
+    """Highjump: r_G of 000 eq 13 (omega_x, omega_z, v_z); obstacle: 000 eq 14 (omega_x, omega_y, omega_z)."""
+    point: dict = dataclasses.field(default_factory=dict)
+    """Target features fixed here are not searched."""
+    ranges: dict = dataclasses.field(default_factory=dict)
+    """{feature: [low, high]}; unset: those of conf/task/<kind>.yaml (ours, enclosing 000 Tables 3-4)."""
+    target: dict = dataclasses.field(default_factory=dict)
+    """Default targets; unset: the take-off of conf/task/<kind>.yaml (highjump: Fosbury flop, 000 Table 3)."""
+    omega_y: Optional[float] = 3.0
+    """Rad/s, fixed omega_y target of the high jump (000 §6.1.1)."""
+    clip: str = "run"
+    """Reference run: pybullet_data humanoid3d_run.txt (000 §6.1.1 used a curved / straight sprint of its own)."""
+    foot: str = "right"
+    """Take-off foot (as conf/task/highjump.yaml; ours)."""
+    n_strides: int = 2
+    """The episode ends at the 2nd take-off-foot mid-support after the start (ours; 000 §3 defines the take-off instant)."""
+    contact_tol: float = 0.06
+    """M: a foot this close to its lowest height is in support (ours, as jumping/takeoff.py)."""
+    foot_clearance: float = 0.002
+    """M: the take-off foot's height at take-off in the reference (ours, as the jump env)."""
+    control_hz: float = 30.0
+    """Hz, policy rate (Peng et al. 2018: 30 Hz); the sim rate is sim.sim_hz (600 Hz, 000 §6.2)."""
+    check_every: int = 1
+    """Substeps between early-termination contact checks (ours: every 600 Hz substep)."""
+    w_imitation: float = 0.7
+    """W_I of r = w_I r_I + w_G r_G (ours: 000 gives no weights; Peng et al. 2018 use 0.7 in their task examples)."""
+    w_goal: float = 0.3
+    """W_G (ours; Peng et al. 2018 use 0.3 there)."""
+    goal_steps: Optional[float] = None
+    """R_G is paid once, at take-off, times this; null: the episode's control steps (ours)."""
+    eval_lead: Optional[float] = None
+    """S before the take-off foot's mid-support that the final rollout starts; null: n_strides whole cycles (ours)."""
+    filmstrip_frames: int = 8
+    """Frames of the final run-up."""
+    filmstrip_width: int = 160
+    """Px per frame."""
+    filmstrip_height: int = 120
+    """Px."""
 
 
-class RunupTask(Task):
+class RunupTask(PolicyTask):
     """DeepMimic run-up to a target take-off state (000 §6.1.1): imitation + take-off reward (eqs 13-14)."""
 
     key_metrics: ClassVar[tuple[str, ...]] = ("goal_reward", "imitation_reward", "mean_return")
     Config: ClassVar[type] = RunupConfig
+    env_path: ClassVar[str] = "jt_tasks.runup.env:RunupEnv"
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
-        self.params = task_params(self.Config, cfg)
         from jt_tasks.runup.reward import GOAL_FEATURES
 
         if self.params.kind not in GOAL_FEATURES:
@@ -109,52 +120,72 @@ class RunupTask(Task):
         _, defaults = self.box()
         feats = {**defaults, **{k: float(v) for k, v in point.items()},
                  **{k: float(v) for k, v in (p.point or {}).items()}}
-        sim = {"sim": plain(group_of(cfg, "sim")), "spd": plain(group_of(cfg, "spd")) or {"name": p.spd},
-               "character": plain(group_of(cfg, "character")) or {"name": "humanoid"}}
-        action = plain(group_of(cfg, "action")) or {"name": p.action}
+        sim, action = self.character_groups()
         return RunupSpec(kind=p.kind, target={k: float(feats[k]) for k in self.feature_names},
                          omega_y=p.omega_y, clip=p.clip, foot=p.foot, n_strides=p.n_strides,
                          contact_tol=p.contact_tol, foot_clearance=p.foot_clearance, control_hz=p.control_hz,
                          check_every=p.check_every, w_imitation=p.w_imitation, w_goal=p.w_goal,
                          goal_steps=p.goal_steps, sim=sim, action=action)
 
-    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
-        """The ``RunupEnv`` with target features ``point`` (missing: the defaults)."""
-        from jt_tasks.runup.env import RunupEnv
+    # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
+    def training(self, spec: Any, ctx: EvalContext) -> Any:
+        from jt_tasks.policy.train import agent_config
+        from jt_tasks.runup.train import goal_hooks
 
-        return RunupEnv(self.env_spec(dict(point or {})), seed=seed)
+        return goal_hooks(agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples, ctx.progress)
 
-    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
-        from jt_tasks.takeoff.state_file import NAME
-        from jt_tasks.runup.train import run_evaluation
+    def final_options(self, env: Any) -> Optional[dict]:
+        from jt_tasks.runup.train import eval_start
 
-        p = self.params
-        spec = self.env_spec(point)
-        out = run_evaluation(spec, group_of(self.cfg, "agent"), Path(ctx.workdir), ctx.seed, group_of(self.cfg, "executor"),
-                             p.eval_lead, p.filmstrip_frames, (p.filmstrip_width, p.filmstrip_height), ctx.progress)
-        ro, res = out["rollout"], out["result"]
+        return {"time": eval_start(env, self.params.eval_lead)}
+
+    def record(self, env: Any) -> dict[str, Any]:
+        out = super().record(env)
+        out["ref_root"] = env.ref.at(env.j0 + env.substeps_done).q[:7].copy()
+        return out
+
+    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
         info = ro["info"]
+        ro["q"], ro["qd"] = env.sim.state()
+        ro["targets"] = dict(env.targets)
+        ro["phase_time"] = float(env.ref.phase(env.clip_time) * env.ref.period)
+        data = {"ref_root": ro["ref_root"], "r_imitation": np.array([t["imitation"] for t in env.terms_log]),
+                "info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))}}
+        attrs = {"kind": spec.kind, "targets": str(ro["targets"]), "return": float(ro["return"]),
+                 "reason": str(info.get("reason", ""))}
+        return data, attrs
+
+    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
+        from jt_tasks.policy.train import last_finite, return_curve
+        from jt_tasks.runup.train import goal_curves
+        from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
+
+        res, info = trained.result, ro["info"]
+        if info.get("took_off"):
+            achieved = {k[len("takeoff_"):]: float(v) for k, v in info.items() if k.startswith("takeoff_")}
+            write_takeoff_state(workdir / NAME, ro["q"], ro["qd"], achieved, ro["targets"], spec.foot, spec.kind,
+                                ro["phase_time"], float(info["r_goal"]))
         metrics = {
             "goal_reward": float(info.get("r_goal", 0.0)),
             "imitation_reward": float(info.get("r_imitation_mean", 0.0)),
             "mean_return": float(ro["return"]),
-            "train_mean_return": _last(res.history.get("mean_return", [])),
+            "train_mean_return": last_finite(res.history.get("mean_return", [])),
             "took_off": float(info.get("took_off", 0.0)),
             "episode_time": float(info.get("episode_time", 0.0)),
             "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": out["samples_per_s"], "train_wall_s": float(out["wall_s"]),
+            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
         }
         for k in ("pose", "vel", "ee", "com"):
             metrics[f"imitation_{k}"] = float(info.get(f"r_{k}_mean", 0.0))
         metrics.update({k: float(v) for k, v in info.items() if k.startswith(("takeoff_", "target_"))})
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
-        arts = [n for n in ("ppo.h5", "rollout.h5", "filmstrip.png", NAME) if (Path(ctx.workdir) / n).exists()]
+        history = {"mean_return": return_curve(trained), **goal_curves(res)}
         if not info.get("took_off"):
-            return Evaluation(metrics=metrics, failed=True, history=out["history"], artifacts=arts,
+            return Evaluation(metrics=metrics, failed=True, history=history,
                               reason=f"the deterministic run-up ended before the take-off: {info.get('reason', '')}")
-        return Evaluation(metrics=metrics, history=out["history"], artifacts=arts)
+        return Evaluation(metrics=metrics, history=history)
 
+    def extra_artifacts(self, workdir: Path) -> list[str]:
+        from jt_tasks.takeoff.state_file import NAME
 
-def _last(values: list) -> float:
-    finite = [float(v) for v in values if math.isfinite(float(v))]
-    return finite[-1] if finite else 0.0
+        return [NAME] if (workdir / NAME).exists() else []

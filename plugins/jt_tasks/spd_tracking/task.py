@@ -82,6 +82,7 @@ class SPDTrackingTask(Task):
     """Mocap tracking with SPD and a hand-of-God root over time steps: error, FPS, SPD share."""
 
     Config: ClassVar[type] = SPDTrackingConfig
+    timing_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "step_us", "spd_us")
     key_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "err_mean_dt30",
                                               "err_mean_dt600", "n_diverged")
 

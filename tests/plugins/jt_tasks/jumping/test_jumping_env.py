@@ -38,10 +38,8 @@ def test_takeoff_state_has_the_imposed_features(env):
     np.testing.assert_allclose(w, [-3.0, 3.0, 1.0], atol=1e-6)  # omega_y fixed at 3 rad/s (000 §6.1.1)
     assert v[2] == pytest.approx(-2.4, abs=1e-6)
     # heading along +x, take-off foot just above the ground, the other foot in the air
-    import pybullet as pb
-
-    foot = pb.getAABB(env.body, env.foot_link, physicsClientId=env.client)[0][1]
-    other = pb.getAABB(env.body, 11, physicsClientId=env.client)[0][1]
+    foot = env.sim.aabb(env.foot_link)[0][1]
+    other = env.sim.aabb(11)[0][1]
     assert foot == pytest.approx(env.spec_.foot_clearance, abs=1e-6)
     assert other > 0.03
 

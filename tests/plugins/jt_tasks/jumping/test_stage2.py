@@ -19,7 +19,8 @@ SMOKE = ["task=highjump", "experiment=smoke", "agent.total_samples=64"]
 def _compose(store, *extra):
     from toolkit.config import compose
 
-    return compose([*SMOKE, f"store={store}", *extra])
+    stage2 = ["reward=highjump_stage2"] if "task.stage=2" in extra and not any(e.startswith("reward=") for e in extra) else []
+    return compose([*SMOKE, f"store={store}", *stage2, *extra])
 
 
 @pytest.fixture(scope="module")
@@ -122,6 +123,7 @@ def test_pi_collects_earlier_stage2_runs_of_the_same_evaluation(stage1):
     (["task.stage=2", "task.init=EMPTY"], "no trained policy"),
     (["task.init=OUTER"], "add task.stage=2"),
     (["task.stage=2", "task.init=OUTER", "search=bds"], "search=single"),
+    (["task.stage=2", "task.init=OUTER", "reward=highjump"], "add reward=highjump_stage2"),
 ])
 def test_bad_init_is_one_line(stage1, extra, match):
     from toolkit.errors import JtError

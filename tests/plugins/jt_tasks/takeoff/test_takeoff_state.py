@@ -10,17 +10,15 @@ import pytest
 
 
 def test_default_v_y_is_the_jump_clips_liftoff_speed():
-    from omegaconf import OmegaConf
-
     from jt_tasks.takeoff.state import liftoff_vertical_speed
-    from toolkit.config import conf_dir
+    from toolkit import plugins
 
     measured = liftoff_vertical_speed("jump")
     assert 1.8 < measured < 2.3  # a standing jump's lift-off, not a run's bounce
     assert liftoff_vertical_speed("run") < 1.0  # the steady run carries no jumping intention
     for task in ("highjump", "obstacle", "longjump"):
-        yaml = OmegaConf.load(Path(conf_dir()) / "task" / f"{task}.yaml")
-        assert yaml.v_y == pytest.approx(measured, abs=0.01), task
+        default = plugins.load("task", task).Config().v_y  # the one source of the default
+        assert default == pytest.approx(measured, abs=0.01), task
 
 
 def test_v_y_replaces_only_the_vertical_root_speed():

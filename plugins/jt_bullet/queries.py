@@ -1,0 +1,225 @@
+"""What an environment asks the ``bullet`` simulator besides stepping: batched link reads,
+contacts, distances, rays, static scene bodies (boxes, heightfields) and rendering.
+
+A mixin of ``BulletSimulator`` (it uses the simulator's ``client``, ``character``, ``_masses``,
+``_link_ids`` and ``char_cfg``); every method is part of ``toolkit.interfaces.Simulator``, except
+the classmethod ``planar_world``: a bullet-only extra that opens a ``jt_bullet.planar.PlanarWorld``
+(a torque-controlled URDF of its own, e.g. the standing-jump paper's planar jumper).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from toolkit.errors import JtError
+
+
+class UnknownName(JtError, KeyError):
+    """A link / joint name the character does not have: a one-line ``JtError`` that is also the
+    ``KeyError`` callers caught before."""
+
+    __str__ = Exception.__str__  # the message as written, not KeyError's quoted repr
+
+
+class SceneQueries:
+    """The query, scene and render half of ``toolkit.interfaces.Simulator`` on PyBullet."""
+
+    # ------------------------------------------------------------------ the character
+    @property
+    def body_id(self) -> int:
+        """PyBullet id of the character (for jt_bullet's own tools)."""
+        return self.character.body_id
+
+    @property
+    def masses(self) -> np.ndarray:
+        """Link masses ``(n_links + 1,)``, base first (kg)."""
+        return self._masses
+
+    def link_states(self, base_only: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Centre-of-mass positions ``(n_links + 1, 3)`` and orientations ``(n_links + 1, 4)`` of
+        the base and every link (world frame, x, y, z, w); ``base_only`` reads row 0 alone."""
+        import pybullet as pb
+
+        kw, b = {"physicsClientId": self.client}, self.character.body_id
+        pos, orn = pb.getBasePositionAndOrientation(b, **kw)
+        if base_only:
+            return np.array([pos]), np.array([orn])
+        states = pb.getLinkStates(b, self._link_ids, **kw)
+        return np.array([pos] + [s[0] for s in states]), np.array([orn] + [s[1] for s in states])
+
+    def link_index(self, name: str) -> int:
+        """PyBullet index of the link called ``name``, else of the joint called ``name`` (its child
+        link); -1 for ``"base"`` / ``"root"`` (when no link or joint has that name).
+
+        Raises:
+            UnknownName: no such link or joint (a ``JtError`` and ``KeyError``; lists the links).
+        """
+        from jt_bullet.scene import find_link
+
+        try:
+            return find_link(self.client, self.character.body_id, str(name))
+        except KeyError as e:
+            raise UnknownName(f"character {self.character.name!r}: {e.args[0]}") from None
+
+    def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
+        """World position ``(3,)`` and orientation x, y, z, w ``(4,)`` of a link's URDF frame
+        (-1: the base frame)."""
+        import pybullet as pb
+
+        kw, b = {"physicsClientId": self.client}, self.character.body_id
+        if link < 0:
+            pos, orn = pb.getBasePositionAndOrientation(b, **kw)
+        else:
+            s = pb.getLinkState(b, link, computeForwardKinematics=True, **kw)
+            pos, orn = s[4], s[5]
+        return np.array(pos), np.array(orn)
+
+    def aabb(self, link: int) -> tuple[np.ndarray, np.ndarray]:
+        """World AABB ``(low (3,), high (3,))`` of a link (-1: the base)."""
+        import pybullet as pb
+
+        lo, hi = pb.getAABB(self.character.body_id, int(link), physicsClientId=self.client)
+        return np.array(lo), np.array(hi)
+
+    def contacts(self, body: Optional[int] = None) -> list[tuple[int, int]]:
+        """``(scene body, character link)`` of every contact point now (of ``body`` only if given)."""
+        import pybullet as pb
+
+        kw = {"physicsClientId": self.client}
+        if body is None:
+            pts = pb.getContactPoints(bodyA=self.character.body_id, **kw)
+        else:
+            pts = pb.getContactPoints(bodyA=self.character.body_id, bodyB=int(body), **kw)
+        return [(int(p[2]), int(p[3])) for p in pts]
+
+    def near(self, body: int, margin: float) -> bool:
+        """True when any part of the character is within ``margin`` m of scene ``body`` (-1: none)."""
+        import pybullet as pb
+
+        if body is None or body < 0:
+            return False
+        pts = pb.getClosestPoints(bodyA=self.character.body_id, bodyB=int(body), distance=float(margin),
+                                  physicsClientId=self.client)
+        return len(pts) > 0
+
+    def ray(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """Hit points ``(n, 3)`` of rays ``starts -> ends`` ``(n, 3)`` against the scene, the
+        character excluded; NaN rows where a ray hits nothing."""
+        import pybullet as pb
+
+        starts, ends = np.asarray(starts, float).reshape(-1, 3), np.asarray(ends, float).reshape(-1, 3)
+        out = np.full(starts.shape, np.nan)
+        me = self.character.body_id
+        for i0 in range(0, len(starts), pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1):
+            chunk = slice(i0, i0 + pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1)
+            hits = pb.rayTestBatch(starts[chunk].tolist(), ends[chunk].tolist(), physicsClientId=self.client)
+            for j, h in enumerate(hits):
+                if h[0] >= 0 and h[0] != me:
+                    out[i0 + j] = h[3]
+                elif h[0] == me:  # the character is in the way: cast again from just past it
+                    out[i0 + j] = self._ray_past_character(starts[i0 + j], ends[i0 + j])
+        return out
+
+    def _ray_past_character(self, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+        import pybullet as pb
+
+        me, s = self.character.body_id, np.array(start, float)
+        for _ in range(16):
+            h = pb.rayTest(s.tolist(), list(map(float, end)), physicsClientId=self.client)[0]
+            if h[0] < 0:
+                return np.full(3, np.nan)
+            if h[0] != me:
+                return np.array(h[3])
+            s = np.array(h[3]) + 1e-4 * (np.asarray(end) - s) / max(np.linalg.norm(np.asarray(end) - s), 1e-12)
+        return np.full(3, np.nan)
+
+    # ------------------------------------------------------------------ scene
+    def add_box(self, half_extents: Sequence[float], position: Sequence[float],
+                orientation: Sequence[float] = (0.0, 0.0, 0.0, 1.0),
+                rgba: Sequence[float] = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> int:
+        """A static box; its handle (a PyBullet body id)."""
+        import pybullet as pb
+
+        kw = {"physicsClientId": self.client}
+        half = [float(v) for v in half_extents]
+        col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, **kw)
+        vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=list(rgba), **kw)
+        body = pb.createMultiBody(0.0, col, vis, list(map(float, position)), list(orientation), **kw)
+        pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
+        return int(body)
+
+    def add_heightfield(self, heights: np.ndarray, cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),
+                        friction: float = 0.9) -> int:
+        """Static terrain ``heights`` ``(n_x, n_z)`` (m) on a ``cell``-metre grid centred at
+        ``origin`` (y up: rows along x, columns along z); its handle."""
+        import pybullet as pb
+
+        from jt_bullet.scene import Z_TO_Y
+
+        h = np.asarray(heights, dtype=float)
+        if h.ndim != 2 or min(h.shape) < 2:
+            raise ValueError(f"heights must be (n_x, n_z) with n_x, n_z >= 2, got {h.shape}")
+        kw = {"physicsClientId": self.client}
+        n_x, n_z = h.shape
+        # PyBullet's heightfield is z-up with data row-major over (rows = y, columns = x) and is
+        # centred on the mid-height; turned by Z_TO_Y its local (x, y, z) become world (x, -z, y).
+        data = h[:, ::-1].T.reshape(-1)  # local y = -world z
+        col = pb.createCollisionShape(pb.GEOM_HEIGHTFIELD, meshScale=[cell, cell, 1.0], heightfieldData=data.tolist(),
+                                      numHeightfieldRows=n_x, numHeightfieldColumns=n_z, **kw)
+        mid = 0.5 * (float(h.max()) + float(h.min()))
+        pos = [float(origin[0]), float(origin[1]) + mid, float(origin[2])]
+        body = pb.createMultiBody(0.0, col, -1, pos, list(Z_TO_Y), **kw)
+        pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
+        return int(body)
+
+    def remove(self, body: int) -> None:
+        """Remove a scene body added by ``add_box`` / ``add_heightfield``."""
+        import pybullet as pb
+
+        pb.removeBody(int(body), physicsClientId=self.client)
+
+    # ------------------------------------------------------------------ output
+    def render(self, width: int = 320, height: int = 240, camera: Any = None,
+               target: Optional[Sequence[float]] = None) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, looking at ``target`` (default:
+        the root) with ``camera`` (default: the character's view, ``character.camera_*``)."""
+        import pybullet as pb
+
+        from jt_bullet.config import DEFAULT_CAMERA
+        from toolkit.render import Camera, render_frame
+
+        if camera is None:
+            d, yaw, pitch = DEFAULT_CAMERA.get(self.char_cfg.name, (3.0, 0.0, -10.0))
+            c = self.char_cfg
+            camera = Camera(distance=d if c.camera_distance is None else c.camera_distance,
+                            yaw=yaw if c.camera_yaw is None else c.camera_yaw,
+                            pitch=pitch if c.camera_pitch is None else c.camera_pitch)
+        if target is None:
+            pos, _ = pb.getBasePositionAndOrientation(self.character.body_id, physicsClientId=self.client)
+            target = [v if math.isfinite(v) else 0.0 for v in pos]
+        return render_frame(self.client, target, width, height, camera)
+
+    # ------------------------------------------------------------------ bullet-only extras
+    @classmethod
+    def planar_world(cls, urdf_path: Any, sim_hz: float, friction: float,
+                     gravity: float = -9.8) -> Any:
+        """A torque-controlled fixed-base URDF on a ground plane in its own PyBullet client.
+
+        For models simulated outside the character/SPD loop (``task=standing_jump``'s planar
+        jumper); see ``jt_bullet.planar``. The caller closes it.
+
+        Args:
+            urdf_path: the model file (z up; its first joints place the root in the plane).
+            sim_hz: simulation rate, Hz (the time step is ``1 / sim_hz``).
+            friction: lateral friction of the ground and of every link.
+            gravity: vertical gravity, m/s² (z axis).
+
+        Returns:
+            A ``jt_bullet.planar.PlanarWorld``.
+        """
+        from jt_bullet.planar import PlanarWorld
+
+        return PlanarWorld(urdf_path, sim_hz, friction, gravity)

@@ -1,0 +1,150 @@
+"""``CharacterEnv``: the ``gymnasium.Env`` base of every policy task's environment.
+
+It owns what all of them share: the simulator and the action space, both loaded through the
+plugin registry from the spec's plain config (the env never names its simulator), the map from
+an action to the PD targets of a control step, the step loop's bookkeeping, rendering and closing.
+A subclass says only what its task is:
+
+* ``setup()``: its scene and references (called once, after the character is loaded);
+* ``start(options)``: put the character in an initial state for a new episode (may draw from
+  ``self.np_random``); returns the reset ``info``;
+* ``observe()``: the observation ``(obs_dim,)`` float32;
+* ``watch``: the termination rules the simulator checks inside the substep loop (``Watch``);
+* ``finish_step(rec)``: from the simulator's step record, ``(reward, terminated, truncated, info)``.
+
+Optionally ``substeps_now()`` (fewer substeps in the last control step) and ``CAMERA`` (a
+``toolkit.render.Camera``'s fields, ``None``: the simulator's view of the character).
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Optional
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from toolkit.interfaces.simulator import Watch
+
+
+def load_simulator(sim: dict) -> Any:
+    """The simulator plugin for ``{"sim": ..., "spd": ..., "character": ...}`` (plain dicts), with
+    its per-step contact summary off (policy envs declare the contacts they care about)."""
+    from omegaconf import OmegaConf
+
+    from toolkit import plugins
+
+    cfg = OmegaConf.create(dict(sim))
+    cfg.sim = OmegaConf.merge(cfg.get("sim") or {}, {"contacts": False})
+    name = str(cfg.sim.get("name") or "bullet")
+    return plugins.load("sim", name)(cfg)
+
+
+class CharacterEnv(gymnasium.Env):
+    """One simulated character driven through an action space at the control rate.
+
+    Attributes:
+        sim: the simulator plugin; ``sim_hz``, ``n_links``, ``masses`` ``(n_links + 1,)`` from it.
+        action_space_: the action-space plugin; ``skeleton`` its skeleton.
+        watch: the termination rules of an episode (set by ``setup``).
+        done: the episode has ended (``step`` then needs a ``reset``).
+        penalty: the action space's ``penalty()`` of the last step's action.
+
+    Args:
+        spec: the task's picklable env spec; needs ``sim`` and ``action`` (plain config dicts).
+        seed: seeds ``self.np_random``.
+        render_mode: ``"rgb_array"``.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    CAMERA: ClassVar[Optional[dict]] = None
+
+    def __init__(self, spec: Any, seed: Optional[int] = None, render_mode: Optional[str] = "rgb_array") -> None:
+        from toolkit import plugins
+
+        super().__init__()
+        self.spec_ = spec
+        self.render_mode = render_mode
+        self.sim = load_simulator(spec.sim)
+        self.sim_hz = float(self.sim.params.sim_hz)
+        self.n_links = int(self.sim.n_links)
+        self.masses = np.asarray(self.sim.masses)
+        action = dict(spec.action)
+        self.action_space_ = plugins.load("action", str(action["name"]))(action, "humanoid")
+        self.skeleton = self.action_space_.skeleton
+        low, high = self.action_space_.bounds()
+        self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
+        self.watch = Watch()
+        self.done = False
+        self.penalty = 1.0
+        if seed is not None:
+            self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
+        self.setup()
+        obs = self.observe()
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
+
+    # ------------------------------------------------------------------ what a task writes
+    def setup(self) -> None:
+        """Build the scene and the references; set ``self.watch``; leave an initial state."""
+
+    def start(self, options: Optional[dict]) -> dict:
+        """Put the character in an initial state for a new episode; the reset ``info``."""
+        raise NotImplementedError
+
+    def observe(self) -> np.ndarray:
+        """The observation ``(obs_dim,)`` float32."""
+        raise NotImplementedError
+
+    def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        """``(reward, terminated, truncated, info)`` from the simulator's step record ``rec``."""
+        raise NotImplementedError
+
+    def substeps_now(self) -> Optional[int]:
+        """Substeps of the next control step; None: the simulator's ``sim_hz / control_hz``."""
+        return None
+
+    # ------------------------------------------------------------------ shared machinery
+    def links_and_com(self) -> tuple[np.ndarray, np.ndarray]:
+        """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)``."""
+        pos, _ = self.sim.link_states()
+        return pos, self.masses @ pos / self.masses.sum()
+
+    def pd_targets(self, action: np.ndarray) -> np.ndarray:
+        """``q_target`` ``(n_q,)`` of an action: the action space's joint targets, the root as now."""
+        targets = self.action_space_.targets(np.asarray(action, dtype=np.float64))
+        self.penalty = float(self.action_space_.penalty())
+        q, _ = self.sim.state()
+        return np.concatenate([q[:7], self.skeleton.dofs_to_joints(targets)])
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None) -> tuple[np.ndarray, dict]:
+        super().reset(seed=seed)
+        self.done = False
+        info = self.start(options)
+        return self.observe(), info
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:
+        if self.done:
+            raise RuntimeError("step() after the episode ended; call reset()")
+        q_target = self.pd_targets(action)
+        rec = self.sim.step(q_target, n_substeps=self.substeps_now(), watch=self.watch)
+        reward, terminated, truncated, info = self.finish_step(rec)
+        self.done = bool(terminated or truncated)
+        obs = self.observe()
+        if self.done:
+            obs = np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0)
+        return obs, float(reward), bool(terminated), bool(truncated), info
+
+    def render(self) -> np.ndarray:
+        """RGB frame ``(240, 320, 3)`` uint8."""
+        return self.render_frame(320, 240)
+
+    def render_frame(self, width: int, height: int) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 (the class's ``CAMERA``, else the simulator's view)."""
+        from toolkit.render import Camera
+
+        return self.sim.render(width, height, Camera(**self.CAMERA) if self.CAMERA else None)
+
+    def close(self) -> None:
+        if getattr(self, "sim", None) is not None:
+            self.sim.close()
+            self.sim = None

@@ -1,0 +1,146 @@
+"""``PolicyTask``: a task whose evaluation trains a policy with PPO on a ``CharacterEnv``.
+
+``evaluate`` is the same for every policy task: build the env spec of the searched point, train
+(``policy.train.train_policy``, resumable from ``ppo.h5``), roll the deterministic policy out once,
+write ``rollout.h5``, ``filmstrip.png`` and ``motion.gif``, and return the task's metrics with the
+training curves. A task subclass says only what is its own:
+
+* ``Config`` (its ``task`` group, defaults with their sources) and ``env_path`` (its env class);
+* ``env_spec(point)``: the picklable spec of its environment (``character_groups()`` gives the
+  simulator, SPD, character and action groups as plain dicts);
+* optionally ``training(spec, ctx)``: PPO hooks (a curriculum, Stage 2's warm start ...);
+  ``final_env(env, hooks)`` / ``final_options(env)``: the deterministic rollout's set-up;
+  ``record(env)``: what to log per control step; ``rollout_data(ro, env, spec)``: what
+  ``rollout.h5`` holds besides ``time``, ``root`` and ``com``; and ``measure(...)``: the metrics.
+
+A task constructed without a config (``Task(None)``) composes its own defaults
+(``jt run task=<name>``), so every group it reads exists.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any, Callable, ClassVar, Optional
+
+import numpy as np
+
+from toolkit.config import group_of, plain, task_params
+from toolkit.interfaces.task import EvalContext, Evaluation, Task
+
+from jt_tasks.policy import train as tr
+
+
+@dataclasses.dataclass
+class Hooks:
+    """PPO hooks a task gives its training (``toolkit.rl.ppo.train``)."""
+
+    on_iteration: Optional[Callable] = None
+    extra: dict = dataclasses.field(default_factory=dict)
+    should_stop: Optional[Callable[[], bool]] = None
+    warm_start: Optional[Path] = None
+    spec: Any = None
+    """The env spec to train and roll out with, when the hooks change it (None: unchanged)."""
+    state: dict = dataclasses.field(default_factory=dict)
+    """The task's own bookkeeping (e.g. the curriculum), for ``final_env`` and ``measure``."""
+
+
+class PolicyTask(Task):
+    """Train a policy, then measure its deterministic rollout (the shared wiring of policy tasks)."""
+
+    env_path: ClassVar[str] = ""
+    """``module:Class`` of the task's ``CharacterEnv`` (imported when first needed)."""
+
+    def __init__(self, cfg: Any = None) -> None:
+        if cfg is None:
+            from toolkit.config import compose
+
+            cfg = compose([f"task={self.Config().name}"])
+        super().__init__(cfg)
+        self.params = task_params(self.Config, cfg)
+
+    # ------------------------------------------------------------------ what a task writes
+    def env_spec(self, point: dict[str, float]) -> Any:
+        """The picklable spec of the environment at ``point`` (missing names: the defaults)."""
+        raise NotImplementedError
+
+    def training(self, spec: Any, ctx: EvalContext) -> Hooks:
+        """PPO hooks of one evaluation (default: none)."""
+        return Hooks()
+
+    def final_env(self, env: Any, hooks: Hooks, trained: tr.Trained) -> None:
+        """Set up the environment of the deterministic rollout (e.g. the reached difficulty)."""
+
+    def final_options(self, env: Any) -> Optional[dict]:
+        """Reset options of the deterministic rollout."""
+        return None
+
+    def record(self, env: Any) -> dict[str, Any]:
+        """What the rollout logs per control step: time, root pose ``(7,)`` and CoM ``(3,)``."""
+        q, _ = env.sim.state()
+        return {"root": q[:7].copy(), "com": env.links_and_com()[1], "time": env.t}
+
+    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
+        """``(datasets, attributes)`` of ``rollout.h5`` besides ``time``, ``root`` and ``com``."""
+        return {}, {"return": float(ro["return"]), "reason": str(ro["info"].get("reason", ""))}
+
+    def measure(self, spec: Any, ro: dict, trained: tr.Trained, hooks: Hooks, workdir: Path) -> Evaluation:
+        """The evaluation's metrics from the deterministic rollout and the training."""
+        res = trained.result
+        metrics = {"mean_return": float(ro["return"]),
+                   "train_mean_return": tr.last_finite(res.history.get("mean_return", [])),
+                   "samples": float(res.samples), "iterations": float(res.iterations),
+                   "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s)}
+        return Evaluation(metrics=metrics, history={"mean_return": tr.return_curve(trained)})
+
+    # ------------------------------------------------------------------ shared wiring
+    @property
+    def env_class(self) -> type:
+        """The task's environment class (``env_path``)."""
+        import importlib
+
+        module, _, name = self.env_path.partition(":")
+        return getattr(importlib.import_module(module), name)
+
+    def character_groups(self) -> tuple[dict, dict]:
+        """``({"sim": ..., "spd": ..., "character": ...}, action)`` as plain dicts (picklable)."""
+        cfg = self.cfg
+        sim = {k: plain(group_of(cfg, k)) for k in ("sim", "spd", "character")}
+        return sim, plain(group_of(cfg, "action"))
+
+    def make_env(self, point: Optional[dict[str, float]] = None, seed: Optional[int] = None) -> Any:
+        """The task's environment at ``point`` (None: the defaults)."""
+        return self.env_class(self.env_spec(dict(point or {})), seed=seed)
+
+    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
+        from toolkit.rl.checkpoint import load_policy
+        from toolkit.store import h5
+
+        p, workdir = self.params, Path(ctx.workdir)
+        spec = self.env_spec(point)
+        hooks = self.training(spec, ctx)
+        spec = hooks.spec if hooks.spec is not None else spec
+        trained = tr.train_policy(tr.EnvFactory(self.env_class, spec), group_of(self.cfg, "agent"),
+                                  group_of(self.cfg, "executor"), workdir, ctx.seed, hooks.on_iteration,
+                                  hooks.extra, hooks.should_stop, hooks.warm_start)
+        model = load_policy(trained.checkpoint)
+        env = self.env_class(spec, seed=ctx.seed)
+        try:
+            self.final_env(env, hooks, trained)
+            ro = tr.rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width, p.filmstrip_height,
+                            self.final_options(env))
+            data, attrs = self.rollout_data(ro, env, spec)
+            fps = float(getattr(env, "control_hz", 30.0))
+        finally:
+            env.close()
+        written = tr.save_motion(workdir, ro["frames"], p.filmstrip_frames, fps)
+        h5.write(workdir / "rollout.h5", {"time": ro["time"], "root": ro["root"], "com": ro["com"], **data}, attrs)
+        ev = self.measure(spec, ro, trained, hooks, workdir)
+        if ev.artifacts is None:
+            ev.artifacts = [n for n in (tr.CHECKPOINT, "rollout.h5", *written) if (workdir / n).exists()] + \
+                self.extra_artifacts(workdir)
+        return ev
+
+    def extra_artifacts(self, workdir: Path) -> list[str]:
+        """Files of the task's own that the evaluation logs besides the shared ones."""
+        return []

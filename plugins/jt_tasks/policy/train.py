@@ -1,0 +1,197 @@
+"""Training and the deterministic rollout of a policy task, shared by every one of them.
+
+``train_policy`` trains PPO (``toolkit.rl.ppo.train``) on a task's environments with the ``agent``
+group's hyper-parameters, in the evaluation's folder (``ppo.h5``, so a killed evaluation resumes),
+opening the ``executor`` for ``agent.n_workers > 1`` and closing it again. ``rollout`` runs the
+trained policy's mean action once, recording what the task asks per control step and rendering
+frames; ``save_motion`` writes them as ``filmstrip.png`` (a few frames side by side) and
+``motion.gif`` (every frame); ``return_curve`` is the training curve against samples.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+CHECKPOINT = "ppo.h5"  #: the policy's checkpoint in an evaluation's folder
+
+
+class EnvFactory:
+    """Picklable ``env_fn(seed) -> env`` for PPO's rollout workers.
+
+    Args:
+        env_class: a ``CharacterEnv`` subclass (module-level, so it pickles by reference).
+        spec: its picklable spec.
+    """
+
+    def __init__(self, env_class: type, spec: Any) -> None:
+        self.env_class, self.spec = env_class, spec
+
+    def __call__(self, seed: int) -> Any:
+        return self.env_class(self.spec, seed=seed)
+
+
+def agent_config(agent: Any, seed: int) -> Any:
+    """``PPOConfig`` of the ``agent`` group (None: the defaults) with the evaluation's ``seed``.
+
+    Raises:
+        JtError: an unknown key, a wrong type or a value out of range (one line).
+    """
+    from toolkit.config import config_of
+    from toolkit.rl.config import PPOConfig
+
+    cfg = config_of(PPOConfig, agent, "agent")
+    return dataclasses.replace(cfg, policy_hidden=tuple(int(v) for v in cfg.policy_hidden),
+                               value_hidden=tuple(int(v) for v in cfg.value_hidden), seed=int(seed))
+
+
+@dataclasses.dataclass
+class Trained:
+    """What ``train_policy`` returns.
+
+    Attributes:
+        result: PPO's ``TrainResult`` (model, counters, per-iteration history, ``extra``).
+        config: the ``PPOConfig`` trained with.
+        wall_s: wall time of the training (s).
+        checkpoint: the ``ppo.h5`` written.
+    """
+
+    result: Any
+    config: Any
+    wall_s: float
+    checkpoint: Path
+
+    @property
+    def samples_per_s(self) -> float:
+        """Mean collection + update throughput over the iterations (NaN before any)."""
+        sps = self.result.history.get("samples_per_s", [])
+        return float(np.mean(sps)) if sps else math.nan
+
+
+def train_policy(env_fn: Callable[[int], Any], agent: Any, executor: Any, workdir: Path, seed: int,
+                 on_iteration: Optional[Callable] = None, extra: Optional[dict] = None,
+                 should_stop: Optional[Callable[[], bool]] = None, warm_start: Optional[Path] = None,
+                 configure: Optional[Callable[[Any], Any]] = None) -> Trained:
+    """Train (or resume) a policy in ``workdir/ppo.h5``.
+
+    Args:
+        env_fn: ``env_fn(seed) -> env``.
+        agent: the ``agent`` group.
+        executor: the ``executor`` group (its plugin holds the rollout workers when
+            ``agent.n_workers > 1``), or None.
+        workdir: the evaluation's folder.
+        seed: the evaluation seed.
+        on_iteration, extra, should_stop: PPO's hooks (``toolkit.rl.ppo.train``).
+        warm_start: a PPO checkpoint whose networks (and their sizes) a fresh run starts from.
+        configure: a last change of the ``PPOConfig`` (e.g. a task's own budget rule).
+    """
+    from toolkit import plugins
+    from toolkit.rl import ppo
+
+    cfg = agent_config(agent, seed)
+    if warm_start is not None:
+        from toolkit.rl.checkpoint import with_architecture
+
+        cfg = with_architecture(cfg, Path(warm_start))
+    if configure is not None:
+        cfg = configure(cfg)
+    pool = None
+    if cfg.n_workers > 1 and executor is not None:
+        pool = plugins.load("executor", str(executor.name))(executor)
+    path = Path(workdir) / CHECKPOINT
+    t0 = time.perf_counter()
+    try:
+        result = ppo.train(env_fn, cfg, pool, path, resume=True, on_iteration=on_iteration, extra=extra,
+                           should_stop=should_stop, warm_start=warm_start)
+    finally:
+        if pool is not None:
+            pool.close()
+    return Trained(result=result, config=cfg, wall_s=time.perf_counter() - t0, checkpoint=path)
+
+
+def rollout(env: Any, model: Any, record: Callable[[Any], dict], frames: int = 0, width: int = 160,
+            height: int = 120, options: Optional[dict] = None) -> dict[str, Any]:
+    """One deterministic episode (the policy's mean action) from ``env.reset(seed=0, options)``.
+
+    Args:
+        env: the environment.
+        model: the policy (``act(obs)``).
+        record: ``record(env) -> {name: value}`` before the first step and after every step.
+        frames: render every control step when > 0 (``frames`` of them go to the filmstrip).
+        width, height: frame size (px).
+        options: the reset options (e.g. a start time).
+
+    Returns:
+        ``return``, ``info`` (the last step's), ``frames`` (every rendered frame), ``steps`` and
+        one array per recorded name, ``(n_steps + 1, ...)``.
+    """
+    obs, _ = env.reset(seed=0, options=options)
+    rows: list[dict] = []
+    imgs: list[np.ndarray] = []
+    done, ret, info, steps = False, 0.0, {}, 0
+
+    def snap() -> None:
+        rows.append(record(env))
+        if frames > 0:
+            imgs.append(env.render_frame(width, height))
+
+    snap()
+    while not done:
+        obs, r, te, tr, info = env.step(model.act(obs).astype(np.float32))
+        ret += r
+        steps += 1
+        done = te or tr
+        snap()
+    out: dict[str, Any] = {"return": ret, "info": info, "frames": imgs, "steps": steps}
+    for key in rows[0]:
+        out[key] = np.array([row[key] for row in rows])
+    return out
+
+
+def pick_frames(frames: list, n: int) -> list:
+    """``n`` frames evenly spread over ``frames`` (first and last included)."""
+    if not frames or n <= 0:
+        return []
+    idx = np.unique(np.linspace(0, len(frames) - 1, n).round().astype(int))
+    return [frames[i] for i in idx]
+
+
+def save_motion(workdir: Path, frames: list, n_filmstrip: int, fps: float = 30.0) -> list[str]:
+    """``filmstrip.png`` (``n_filmstrip`` frames side by side) and ``motion.gif`` (all frames at
+    ``fps``) in ``workdir``; the names written."""
+    import imageio.v3 as iio
+
+    if not frames:
+        return []
+    strip = pick_frames(frames, n_filmstrip)
+    iio.imwrite(Path(workdir) / "filmstrip.png",
+                np.concatenate([np.asarray(f)[..., :3] for f in strip], axis=1).astype(np.uint8))
+    iio.imwrite(Path(workdir) / "motion.gif", np.stack([np.asarray(f)[..., :3] for f in frames]).astype(np.uint8),
+                duration=1000.0 / max(float(fps), 1e-3), loop=0)
+    return ["filmstrip.png", "motion.gif"]
+
+
+def samples_axis(trained: Trained) -> list[int]:
+    """Samples collected after each iteration ``(n_iterations,)``."""
+    cfg = trained.config
+    n_envs = cfg.n_workers * cfg.envs_per_worker
+    per_it = n_envs * math.ceil(cfg.samples_per_iteration / n_envs)
+    n_it = len(trained.result.history.get("mean_return", []))
+    return [per_it * (i + 1) for i in range(n_it)]
+
+
+def return_curve(trained: Trained) -> list[tuple[int, float]]:
+    """``[(samples, mean episode return)]`` per iteration, iterations with no episode left out."""
+    values = trained.result.history.get("mean_return", [])
+    return [(s, float(v)) for s, v in zip(samples_axis(trained), values) if math.isfinite(v)]
+
+
+def last_finite(values: list) -> float:
+    """The last finite value of ``values`` (0.0 if none)."""
+    finite = [float(v) for v in values if math.isfinite(float(v))]
+    return finite[-1] if finite else 0.0

