@@ -17,6 +17,7 @@ from typing import Any, Optional
 
 from jt_curricula import schedules
 from jt_curricula.base import IterationCurriculum, finite_or
+from toolkit.errors import JtError
 
 _TOL = 1e-9
 
@@ -57,9 +58,9 @@ class BarHeightCurriculum(IterationCurriculum):
         super().__init__(cfg)
         p = self.params
         if not (p.dz > 0 and p.z_max >= p.z_min and p.reward_threshold >= 0):
-            raise ValueError(f"{type(self).__name__}: need dz > 0, z_max >= z_min, R_T >= 0; got {p}")
+            raise JtError(f"{type(self).__name__}: need dz > 0, z_max >= z_min, R_T >= 0; got {p}")
         if p.signal not in ("mean_return", "mean_reward"):
-            raise ValueError(f"{type(self).__name__}: signal must be mean_return or mean_reward, got {p.signal!r}")
+            raise JtError(f"{type(self).__name__}: signal must be mean_return or mean_reward, got {p.signal!r}")
         self.max_level = max(0, math.ceil((p.z_max - p.z_min) / p.dz - _TOL))
         self.level = 0
         self.accumulator = 0.0

@@ -13,6 +13,7 @@ import dataclasses
 from typing import Any
 
 from jt_curricula.base import IterationCurriculum
+from toolkit.errors import JtError
 
 
 class TerrainCurriculum(IterationCurriculum):
@@ -40,7 +41,7 @@ class TerrainCurriculum(IterationCurriculum):
         super().__init__(cfg)
         p = self.params
         if not p.regions or p.successes_to_unlock < 1 or p.fixed_every_samples < 0:
-            raise ValueError(f"terrain: need regions, successes_to_unlock >= 1, fixed_every_samples >= 0; got {p}")
+            raise JtError(f"terrain: need regions, successes_to_unlock >= 1, fixed_every_samples >= 0; got {p}")
         self.level = 0  # highest unlocked region index; regions 0..level are all in use
         self.successes = 0  # successes counted towards the next unlock
         self.episodes = 0

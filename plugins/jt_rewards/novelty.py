@@ -10,6 +10,7 @@ import numpy as np
 
 from jt_rewards.base import RecordTerm
 from jt_rewards.distances import resolve
+from toolkit.errors import JtError
 
 
 class Novelty(RecordTerm):
@@ -40,9 +41,9 @@ class Novelty(RecordTerm):
         super().__init__(cfg)
         p = self.params
         if not p.d_threshold > 0:
-            raise ValueError(f"novelty: d_threshold must be > 0, got {p.d_threshold}")
+            raise JtError(f"novelty: d_threshold must be > 0, got {p.d_threshold}")
         if not 0 <= p.low <= p.high:
-            raise ValueError(f"novelty: need 0 <= low <= high, got {p.low}, {p.high}")
+            raise JtError(f"novelty: need 0 <= low <= high, got {p.low}, {p.high}")
         self.distance = resolve(p.distance)
 
     def min_distance(self, feature: Any, policy_features: Any) -> float:

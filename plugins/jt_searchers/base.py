@@ -9,6 +9,7 @@ import numpy as np
 
 from toolkit.interfaces.searcher import SearchProblem, Searcher
 from toolkit.config import config_of
+from toolkit.errors import JtError
 
 
 def seed_int(*entropy: int) -> int:
@@ -50,7 +51,7 @@ class UnitBox:
         self.high = np.asarray(problem.space.highs, dtype=float)
         self.dim = len(self.low)
         if np.any(self.high < self.low):
-            raise ValueError("every parameter needs low <= high")
+            raise JtError("every parameter needs low <= high")
         self.span = np.where(self.high > self.low, self.high - self.low, 1.0)
 
     def to_unit(self, x: np.ndarray) -> np.ndarray:

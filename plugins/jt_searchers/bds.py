@@ -28,6 +28,7 @@ from jt_searchers.distances import resolve
 from jt_searchers.gp import FeatureGP
 from jt_searchers.optimize import maximize_direct, maximize_lbfgsb
 from jt_searchers.random_search import unit_samples
+from toolkit.errors import JtError
 
 KINDS = ("init", "explore", "diversity")
 
@@ -64,9 +65,9 @@ class BDSSearcher(BudgetedSearcher):
         super().__init__(problem, cfg, seed)
         c = self.cfg
         if problem.n_features <= 0:
-            raise ValueError("bds needs a task whose problem() declares n_features > 0")
+            raise JtError("bds needs a task whose problem() declares n_features > 0")
         if c.n_init < 1 or c.n_exp < 0 or c.n_opt < 0 or c.n_exp + c.n_opt < 1:
-            raise ValueError("bds needs n_init >= 1 and n_exp + n_opt >= 1")
+            raise JtError("bds needs n_init >= 1 and n_exp + n_opt >= 1")
         m = problem.n_features
         low = np.asarray(problem.feature_low if problem.feature_low is not None else [-1.0] * m, float)
         high = np.asarray(problem.feature_high if problem.feature_high is not None else [1.0] * m, float)

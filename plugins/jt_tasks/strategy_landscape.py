@@ -25,6 +25,7 @@ import numpy as np
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 from toolkit.config import task_params
+from toolkit.errors import JtError
 
 
 class StrategyLandscapeTask(Task):
@@ -81,7 +82,7 @@ class StrategyLandscapeTask(Task):
                 if np.all(np.linalg.norm(plateaus - cand, axis=1) >= p.min_separation):
                     break
             else:
-                raise ValueError("cannot separate the plateaus: lower min_separation or n_strategies")
+                raise JtError("cannot separate the plateaus: lower min_separation or n_strategies")
             plateaus = np.vstack([plateaus, cand])
         self.plateaus = plateaus
         if p.layout == "quantised":
@@ -97,7 +98,7 @@ class StrategyLandscapeTask(Task):
             self.sites = rng.random((p.n_strategies, p.dims))
             self.weights = p.latent_scale * rng.random(p.n_strategies) ** 2
         else:
-            raise ValueError(f"unknown layout {p.layout!r} (use 'quantised' or 'voronoi')")
+            raise JtError(f"unknown layout {p.layout!r} (use 'quantised' or 'voronoi')")
         self._volumes: np.ndarray | None = None
         self.failing: set[int] = set()
         if p.n_failing:

@@ -21,6 +21,7 @@ import numpy as np
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 from toolkit.config import task_params
+from toolkit.errors import JtError
 
 
 def zdt1(x: np.ndarray) -> np.ndarray:
@@ -70,7 +71,7 @@ class ZDT1Task(Task):
         super().__init__(cfg)
         self.params = task_params(self.Config, cfg)
         if self.params.n_var < 2:
-            raise ValueError("zdt1 needs n_var >= 2")
+            raise JtError("zdt1 needs n_var >= 2")
 
     def problem(self) -> SearchProblem:
         return SearchProblem(

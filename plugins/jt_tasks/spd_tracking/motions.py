@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.motion import rotations as rot
+from toolkit.errors import JtError
 
 #: z-up, facing +y (laikago mocap) -> y-up, facing +x: -90 deg about x (z -> y), then -90 deg
 #: about y (-z -> +x)
@@ -116,7 +117,7 @@ class ClipReference(Reference):
         super().__init__(joint_dofs, clip.name, clip.duration)
         expected = [j.bullet_index for j in clip.skeleton.joints]
         if list(map(int, joint_indices)) != expected:
-            raise ValueError(f"clip {clip.name!r} ({clip.skeleton.name}) drives joints {expected}, "
+            raise JtError(f"clip {clip.name!r} ({clip.skeleton.name}) drives joints {expected}, "
                              f"the character has {list(joint_indices)}")
         self.clip = clip
         self.to_world = np.array([0.0, 0.0, 0.0, 1.0]) if to_world is None else np.asarray(to_world)
@@ -197,12 +198,12 @@ def motion_path(character: str, motion: str) -> str:
         return motion
     prefix = {"humanoid": "humanoid3d_", "laikago": "laikago_"}.get(character)
     if prefix is None:
-        raise ValueError(f"no mocap for character {character!r}")
+        raise JtError(f"no mocap for character {character!r}")
     path = os.path.join(motions_dir(), f"{prefix}{motion}.txt")
     if not os.path.exists(path):
         known = sorted(f[len(prefix):-4] for f in os.listdir(motions_dir())
                        if f.startswith(prefix) and f.endswith(".txt"))
-        raise ValueError(f"no motion {motion!r} for {character}; choose one of: {', '.join(known)}")
+        raise JtError(f"no motion {motion!r} for {character}; choose one of: {', '.join(known)}")
     return path
 
 
@@ -224,14 +225,14 @@ def make_reference(character: Any, motion: str, wave: WaveParams | None = None) 
     name = character.name
     motion = default_motion(name) if motion in ("auto", "", None) else motion
     if not motion:
-        raise ValueError(f"no motion for character {name!r}: tracking supports humanoid "
+        raise JtError(f"no motion for character {name!r}: tracking supports humanoid "
                          "(mocap clips), laikago (walk) and the snakes (slither)")
     if motion == "slither":
         if not name.startswith("snake"):
-            raise ValueError(f"motion 'slither' is for the snakes, not {name!r}")
+            raise JtError(f"motion 'slither' is for the snakes, not {name!r}")
         return SnakeWave(character.joint_dofs, wave)
     if name.startswith("snake"):
-        raise ValueError(f"the snakes track the generated 'slither', not {motion!r}")
+        raise JtError(f"the snakes track the generated 'slither', not {motion!r}")
     clip = load_clip(motion_path(name, motion))
     to_world = LAIKAGO_TO_WORLD if clip.skeleton.up_axis == 2 else None
     return ClipReference(clip, character.joint_indices, character.joint_dofs, to_world)

@@ -23,6 +23,7 @@ from typing import Any, ClassVar, Optional, Sequence
 from jt_tasks.spd_tracking.motions import WaveParams
 from toolkit.config import plain
 from toolkit.interfaces import EvalContext, Evaluation, Task
+from toolkit.errors import JtError
 
 FPS_RATE = {"laikago": 240.0}  #: 001 §2.4.2: dt = 1/240 for the dog, 1/30 otherwise
 DEFAULT_FPS_RATE = 30.0
@@ -140,7 +141,7 @@ class SPDTrackingTask(Task):
         duration = p.duration if p.duration > 0 else 2.0 * ref.duration
         rates = [float(r) for r in p.rates_hz]
         if not rates or any(not r > 0 for r in rates):
-            raise ValueError(f"task.rates_hz must be positive rates, got {p.rates_hz}")
+            raise JtError(f"task.rates_hz must be positive rates, got {p.rates_hz}")
         fps_rate = p.fps_rate_hz or FPS_RATE.get(facts["character"], DEFAULT_FPS_RATE)
         render_rate = (p.render_rate_hz or max(rates)) if p.render else None
         plan = sorted(set(rates) | ({float(render_rate)} if render_rate else set()))

@@ -6,6 +6,8 @@ import math
 
 import pytest
 
+from toolkit.errors import JtError
+
 from curriculum_contract import CurriculumContract, iteration_stats
 from jt_curricula import schedules
 from jt_curricula.bar_height import BarHeightCurriculum, ObstacleWidthCurriculum
@@ -97,7 +99,7 @@ class TestBarHeight(CurriculumContract):
             rew.on_iteration(i, samples, iteration_stats(scalars, eps))
         assert ret.level == 1 and ret.accumulator == 20.0  # 20, 40 > 30 → step, 20
         assert rew.level == 0 and rew.accumulator == 3.0 and rew.episodes == 12
-        with pytest.raises(ValueError, match="signal"):
+        with pytest.raises(JtError, match="signal"):
             BarHeightCurriculum({"signal": "median"})
 
 

@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from toolkit.errors import JtError
+
 from jt_rewards.distances import angle, quat, resolve, rotvec
 from jt_rewards.novelty import Novelty
 from reward_contract import RewardTermContract
@@ -87,7 +89,7 @@ class TestNovelty(RewardTermContract):
     def test_bad_config_rejected(self):
         with pytest.raises(ValueError, match="unknown feature distance"):
             Novelty({"distance": "manhattan"})
-        with pytest.raises(ValueError):
+        with pytest.raises(JtError):
             Novelty({"d_threshold": 0.0})
         assert resolve("quat") is quat
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
+from toolkit.errors import JtError
 from scipy.stats import norm
 
 from jt_searchers.acquisition import ExpectedDiversity, Exploration
@@ -184,7 +186,7 @@ def test_the_task_feature_distance_is_used() -> None:
 def test_needs_features() -> None:
     from jt_tasks.zdt import ZDT1Task
 
-    with pytest.raises(ValueError, match="n_features"):
+    with pytest.raises(JtError, match="n_features"):
         BDSSearcher(ZDT1Task({"task": {}}).problem(), {}, 0)
 
 

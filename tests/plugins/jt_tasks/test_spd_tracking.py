@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from toolkit.errors import JtError
+
 from toolkit.interfaces import EvalContext
 
 TRACK = {"sim": {"name": "bullet", "torque_limits": False, "contacts": False,
@@ -104,9 +106,9 @@ def test_unknown_motion_lists_the_choices():
 
     ch = loaded("humanoid")
     pb.disconnect(ch.client)
-    with pytest.raises(ValueError, match="backflip"):
+    with pytest.raises(JtError, match="backflip"):
         make_reference(ch, "moonwalk")
-    with pytest.raises(ValueError, match="slither"):
+    with pytest.raises(JtError, match="slither"):
         make_reference(ch, "slither")
 
 
