@@ -100,13 +100,25 @@ def typed_node(where: str, cls: type, node: Any, overrides: Sequence[tuple[str, 
         raise _schema_error(where, cls, e) from e
     for key, value in overrides:
         try:
-            OmegaConf.update(merged, key, value, merge=True, force_add=False)
+            try:
+                OmegaConf.update(merged, key, value, merge=True, force_add=False)
+            except Exception as e:  # noqa: BLE001 - [[0, 0.5]] for a list of float lists: say 0.0
+                if "(int) is incompatible with type hint 'float'" not in str(e):
+                    raise
+                OmegaConf.update(merged, key, _floats(value), merge=True, force_add=False)
         except Exception as e:  # noqa: BLE001
             msg = _first_line(e)
             if "not in" in msg or "Key '" in msg or "Could not" in msg:
                 raise JtError(f"unknown key '{group}.{key}' ({where}; valid keys: {_valid_keys(cls)})") from e
             raise JtError(f"{group}.{key}={value}: {msg}") from e
     return merged
+
+
+def _floats(value: Any) -> Any:
+    """``value`` with every int inside lists turned into a float (OmegaConf does not widen them)."""
+    if isinstance(value, (list, tuple)):
+        return [_floats(v) for v in value]
+    return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
 
 
 def check_node(where: str, cls: type, node: Any) -> None:

@@ -11,11 +11,14 @@ from toolkit.interfaces.executor import ActorGroup, Executor
 from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.reward import RewardTerm
 from toolkit.interfaces.searcher import Param, SearchProblem, Searcher, Space
-from toolkit.interfaces.simulator import Simulator
+from toolkit.interfaces.simulator import BASE, ContactRule, Simulator, Watch
 from toolkit.interfaces.spd import SPDBackend
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
 __all__ = [
+    "BASE",
+    "ContactRule",
+    "Watch",
     "ActionSpace",
     "ActorGroup",
     "Curriculum",

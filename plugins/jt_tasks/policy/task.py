@@ -78,7 +78,7 @@ class PolicyTask(Task):
     def record(self, env: Any) -> dict[str, Any]:
         """What the rollout logs per control step: time, root pose ``(7,)`` and CoM ``(3,)``."""
         q, _ = env.sim.state()
-        return {"root": q[:7].copy(), "com": env.links_and_com()[1], "time": env.t}
+        return {"root": q[:7].copy(), "com": env.links_and_com()[1], "time": float(getattr(env, "t", env.sim.time))}
 
     def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
         """``(datasets, attributes)`` of ``rollout.h5`` besides ``time``, ``root`` and ``com``."""

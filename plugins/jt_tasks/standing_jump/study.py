@@ -18,26 +18,26 @@ from typing import Any, Sequence
 
 import numpy as np
 
-SEARCHERS = {
+SEARCHERS = {  # label: (registry name, search config)
     # 004 §4.3 / §5: mu = 16, at most 3 failed children per generation
-    "rmoo": ("jt_searchers.rmoo:RMOOSearcher", {"batch": 16, "mu": 16, "sigma0": 0.015, "max_failed": 3}),
+    "rmoo": ("rmoo", {"batch": 16, "mu": 16, "sigma0": 0.015, "max_failed": 3}),
     # the same with Voss et al. (2010)'s success rule (not the paper's)
-    "rmoo_selected": ("jt_searchers.rmoo:RMOOSearcher", {"batch": 16, "mu": 16, "sigma0": 0.015, "max_failed": 3,
+    "rmoo_selected": ("rmoo", {"batch": 16, "mu": 16, "sigma0": 0.015, "max_failed": 3,
                                                          "success": "selected"}),
     # 004 §4.1 as configured by default: 16 bins, 16 offspring, sigma0 0.015, the budget shared by the bins
-    "bsoo": ("jt_searchers.bsoo:BSOOSearcher", {}),
+    "bsoo": ("bsoo", {}),
     # BSOO re-tuned to a small budget (ours): 4 bins of head height over 1.6-2.4 m, 8 offspring
-    "bsoo_4bins": ("jt_searchers.bsoo:BSOOSearcher", {"batch": 8, "popsize": 8, "n_bins": 4, "sigma0": 0.015,
+    "bsoo_4bins": ("bsoo", {"batch": 8, "popsize": 8, "n_bins": 4, "sigma0": 0.015,
                                                       "bin_low": -2.4, "bin_high": -1.6}),
-    "random": ("jt_searchers.random_search:RandomSearcher", {"batch": 16}),
+    "random": ("random", {"batch": 16}),
 }
 
 
-def _load(path: str) -> type:
-    import importlib
+def _load(name: str) -> type:
+    """A searcher class through the registry (a plugin never imports another plugin)."""
+    from toolkit import plugins
 
-    mod, name = path.split(":")
-    return getattr(importlib.import_module(mod), name)
+    return plugins.load("search", name)
 
 
 def _evaluate(args: tuple[dict, int]) -> Any:

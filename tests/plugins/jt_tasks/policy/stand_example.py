@@ -1,0 +1,55 @@
+"""The minimal policy task of docs/writing-a-plugin.md, verbatim (but for its module path)."""
+
+import dataclasses
+import numpy as np
+from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.task import PolicyTask
+from toolkit.interfaces import ContactRule, Watch
+
+@dataclasses.dataclass
+class StandSpec:                      # picklable: rollout workers rebuild the env from it
+    sim: dict
+    action: dict
+    time_limit: float = 5.0
+
+class StandEnv(CharacterEnv):
+    FEET = (5, 11)                    # the humanoid's ankle links
+
+    def setup(self):                  # scene + termination rules, checked inside the 600 Hz loop
+        self.watch = Watch(rules=(ContactRule(self.sim.ground, "fail", "fell", except_links=self.FEET),),
+                           time_limit=self.spec_.time_limit, time_limit_outcome="truncate")
+        self.q0, self.qd0 = self.sim.state()
+
+    def start(self, options):         # an initial state per episode
+        self.sim.reset(self.q0, self.qd0)
+        return {}
+
+    def observe(self):
+        q, qd = self.sim.state()
+        return np.concatenate([q, qd]).astype(np.float32)
+
+    def finish_step(self, rec):       # reward, terminated, truncated, info from the step record
+        fell = rec["outcome"] == "fail"
+        return (0.0 if fell else 1.0), fell, rec["outcome"] == "truncate", {"reason": rec["reason"]}
+
+@dataclasses.dataclass
+class StandConfig:
+    name: str = "stand"
+    """Registry name."""
+    time_limit: float = 5.0
+    """s of standing asked for (ours)."""
+    filmstrip_frames: int = 4
+    """Frames of the final rollout's filmstrip."""
+    filmstrip_width: int = 160
+    """px."""
+    filmstrip_height: int = 120
+    """px."""
+
+class StandTask(PolicyTask):
+    """Stay up: a minimal policy task."""
+    Config = StandConfig
+    env_path = "stand_example:StandEnv"
+
+    def env_spec(self, point):
+        sim, action = self.character_groups()      # sim, spd, character, action groups as dicts
+        return StandSpec(sim=sim, action=action, time_limit=self.params.time_limit)
