@@ -124,3 +124,41 @@ def bench_ppo(
         json_out.write_text(json.dumps({"machine": machine_info(), **res}, indent=2, default=float))
     if not ok:
         raise typer.Exit(1)
+
+
+@bench_app.command("rollout")
+def bench_rollout(
+    tasks: str = typer.Option("highjump", "--tasks", help="Comma list of policy tasks (their envs)."),
+    spd: str = typer.Option("maba", "--spd", help=f"SPD backend, one of {', '.join(BACKENDS)}."),
+    rates: str = typer.Option("10,30", "--rates", help="Control rates (Hz) of the env measurement."),
+    steps: int = typer.Option(400, "--steps", help="Timed control steps per rate."),
+    collect_steps: int = typer.Option(64, "--collect-steps", help="Collection steps per env (16 envs per worker)."),
+    workers: str = typer.Option("1,2", "--workers", help="Worker counts of the collection measurement."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
+) -> None:
+    """Where a policy env's time goes per 600 Hz substep, and PPO collection samples/s per worker."""
+    from toolkit import plugins
+    from toolkit.rl.rollout_bench import format_table, run_bench
+
+    if len(_split(spd, BACKENDS, "backend")) != 1:
+        raise JtError(f"--spd takes one backend, got {spd!r}; choose from: {', '.join(BACKENDS)}")
+    names = [t.strip() for t in tasks.split(",") if t.strip()]
+    for t in names:
+        plugins.load("task", t)  # one clear line for an unknown task
+    try:
+        rate_list = [float(r) for r in rates.split(",") if r.strip()]
+        worker_list = tuple(int(w) for w in workers.split(",") if w.strip())
+    except ValueError:
+        raise JtError(f"--rates and --workers take comma lists of numbers, got {rates!r}, {workers!r}") from None
+    if not rate_list or any(r <= 0 for r in rate_list) or not worker_list or any(w < 1 for w in worker_list):
+        raise JtError("--rates must be positive rates and --workers counts >= 1")
+    out = {"machine": machine_info(), "results": []}
+    for t in names:
+        typer.echo(f"{t}: measuring ...")
+        res = run_bench(t, ["action=raw", f"spd={spd}"], rate_list, steps, collect_steps, worker_list, echo=typer.echo)
+        typer.echo(format_table(res))
+        out["results"].append(res)
+    if json_out:
+        json_out.parent.mkdir(parents=True, exist_ok=True)
+        json_out.write_text(json.dumps(out, indent=2))
+        typer.echo(f"wrote {json_out}")

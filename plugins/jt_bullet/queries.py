@@ -64,6 +64,31 @@ class SceneQueries:
         except KeyError as e:
             raise UnknownName(f"character {self.character.name!r}: {e.args[0]}") from None
 
+    def com(self) -> np.ndarray:
+        """The character's centre of mass ``(3,)`` now (forward kinematics of the current state)."""
+        q, _ = self.io.read()
+        return self.com_now(q)
+
+    def com_now(self, q: np.ndarray) -> np.ndarray:
+        """The CoM ``(3,)`` of configuration ``q`` by the model's forward kinematics (numba, a few
+        µs; PyBullet's cached link frames lag one substep behind the integrated state)."""
+        fk = getattr(self, "_com_fk", None)
+        if fk is None:
+            from toolkit.dynamics.com import CenterOfMass
+
+            fk = self._com_fk = CenterOfMass(self.model)
+        return fk(q)
+
+    def link_positions(self) -> tuple[np.ndarray, tuple, tuple]:
+        """Centre-of-mass positions ``(n_links + 1, 3)`` of the base and every link, with the base's
+        position and orientation as PyBullet returned them (the hot path of ``Watch.record``)."""
+        import pybullet as pb
+
+        kw, b = {"physicsClientId": self.client}, self.character.body_id
+        pos, orn = pb.getBasePositionAndOrientation(b, **kw)
+        states = pb.getLinkStates(b, self._link_ids, **kw)
+        return np.array([pos, *[s[0] for s in states]]), pos, orn
+
     def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
         """World position ``(3,)`` and orientation x, y, z, w ``(4,)`` of a link's URDF frame
         (-1: the base frame)."""

@@ -11,9 +11,11 @@ step. A hand-of-God root servo (``sim.root_servo``, thesis ``001`` §2.4.1) puts
 A NaN or exploding state ends the episode as a failure with a reason (later steps return the
 same failed record without simulating); ``step`` never raises for it.
 
-Timers: ``timers["spd_s"]`` accumulates the wall time of the SPD solves alone,
-``timers["substep_s"]`` that of whole substeps (read state, solve, clip, apply, step), and
-``timers["substeps"]`` their count; ``spd_share`` is the thesis' Table 2.3 ratio. Setting
+Timers: ``timers["spd_s"]`` accumulates the wall time of the SPD solves alone, ``physics_s`` that
+of PyBullet's ``stepSimulation``, ``io_s`` state reads and torque writes (with the clip),
+``substep_s`` that of whole substeps (solve, clip, apply, step, read), ``loop_s`` whole control
+steps' substep loops (with the NaN checks and the ``Watch``), and ``substeps`` their count;
+``spd_share`` is the thesis' Table 2.3 ratio. Setting
 ``step_log`` to a list makes every substep append ``(spd_s, substep_s)`` to it (for medians).
 """
 
@@ -66,6 +68,7 @@ class BulletSimulator(SceneQueries, Simulator):
             raise JtError(f"sim: sim_hz / control_hz must be a whole number >= 1, got "
                           f"{p.sim_hz} / {p.control_hz} = {ratio:g}")
         self.n_substeps = int(round(ratio))
+        self._explode_d2 = float(p.explode_distance) ** 2
         self.dt = 1.0 / p.sim_hz
         spd_node = _get(cfg, "spd")
         spd_name = str(_get(spd_node, "name") or "maba")
@@ -105,11 +108,12 @@ class BulletSimulator(SceneQueries, Simulator):
             self.kd[:6] = p.root_servo.kd
             limit[:6] = np.inf if p.root_servo.kp or p.root_servo.kd else 0.0
         self.torque_limit = limit
+        self._neg_limit = -limit
         self._tau = np.zeros(self.model.n_v)
         self.time = 0.0
         self.failed = False
         self.reason = ""
-        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "substeps": 0}
+        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "physics_s": 0.0, "io_s": 0.0, "loop_s": 0.0, "substeps": 0}
         self.step_log: list | None = None
         self._last: dict[str, Any] = {}
 
@@ -208,28 +212,38 @@ class BulletSimulator(SceneQueries, Simulator):
         vt = None if qd_target is None else np.ascontiguousarray(qd_target, dtype=float)
         n = self.n_substeps if n_substeps is None else int(n_substeps)
         kp, kd, lim, dt, tau = self.kp, self.kd, self.torque_limit, self.dt, self._tau
+        neg_lim = self._neg_limit
+        solve = getattr(be, "solve", be.torques)  # the backend's lean path when it has one
         check = watcher.Checker(self, watch, n)
         perf = time.perf_counter
-        spd_s = sub_s = 0.0
+        spd_s = sub_s = phys_s = io_s = 0.0
         done = 0
+        t_start = perf()
         q, qd = io.read()
         for k in range(n):
             t0 = perf()
             if self.steps_itself:
                 be.apply(qt, kp, kd, lim, vt)
                 ts = 0.0
+                t2 = perf()
             else:
+                raw = solve(q, qd, qt, kp, kd, dt, vt)
                 t1 = perf()
-                raw = be.torques(q, qd, qt, kp, kd, dt, vt)
-                ts = perf() - t1
-                np.clip(raw, -lim, lim, out=tau)
-                if not math.isfinite(float(tau.sum())):
+                ts = t1 - t0
+                np.minimum(raw, lim, out=tau)
+                np.maximum(tau, neg_lim, out=tau)
+                if not io.write_torques(tau):
                     self._fail("non-finite SPD torques (NaN or exploding state)")
                     break
-                io.write_torques(tau)
+                t2 = perf()
+                io_s += t2 - t1
             pb.stepSimulation(**kw)
+            t3 = perf()
             q, qd = io.read()
-            dt_sub = perf() - t0
+            t4 = perf()
+            phys_s += t3 - t2
+            io_s += t4 - t3
+            dt_sub = t4 - t0
             sub_s += dt_sub
             spd_s += ts
             done += 1
@@ -237,11 +251,15 @@ class BulletSimulator(SceneQueries, Simulator):
             if self.step_log is not None:
                 self.step_log.append((ts, dt_sub))
             self._check(q, qd)
-            if self.failed or check.after_substep(k):
+            if self.failed or check.after_substep(k, q):
                 break
-        self.timers["spd_s"] += spd_s
-        self.timers["substep_s"] += sub_s
-        self.timers["substeps"] += done
+        tm = self.timers
+        tm["spd_s"] += spd_s
+        tm["substep_s"] += sub_s
+        tm["physics_s"] += phys_s
+        tm["io_s"] += io_s
+        tm["loop_s"] += perf() - t_start
+        tm["substeps"] += done
         rec = {"time": self.time, "q": q.copy(), "qd": qd.copy(),
                "tau": np.full(self.model.n_v, np.nan) if self.steps_itself else tau.copy()}
         if self.params.contacts:
@@ -278,17 +296,21 @@ class BulletSimulator(SceneQueries, Simulator):
 
     def reset_timers(self) -> None:
         """Zero the SPD / substep timers."""
-        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "substeps": 0}
+        self.timers = {"spd_s": 0.0, "substep_s": 0.0, "physics_s": 0.0, "io_s": 0.0, "loop_s": 0.0, "substeps": 0}
 
     def _check(self, q: np.ndarray, qd: np.ndarray) -> None:
-        p = self.params
+        """NaN / exploding state → failure. Runs after every substep on the state ``io.read``
+        just returned, with the maximum speed and finiteness it computed alongside."""
+        p, io = self.params, self.io
+        vmax = io.speed_max
+        if io.finite and vmax <= p.explode_speed and (
+                self.character.fixed_base or q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= self._explode_d2):
+            return
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
             self._fail("NaN state")
-            return
-        vmax = float(np.max(np.abs(qd))) if qd.size else 0.0
-        if vmax > p.explode_speed:
+        elif vmax > p.explode_speed:
             self._fail(f"exploded: |qd| = {vmax:.3g} > explode_speed = {p.explode_speed:g}")
-        elif not self.character.fixed_base and float(np.linalg.norm(q[:3])) > p.explode_distance:
+        else:
             self._fail(f"exploded: root {float(np.linalg.norm(q[:3])):.3g} m from the origin")
 
     def _fail(self, reason: str) -> None:

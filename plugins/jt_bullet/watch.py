@@ -46,13 +46,13 @@ class Checker:
         self.outcome, self.reason = "", ""
         self._need_contacts = active and bool(watch.rules or watch.touches)
 
-    def after_substep(self, k: int) -> bool:
-        """Check after substep ``k`` (0-based) when it is a checked one; True ends the step."""
+    def after_substep(self, k: int, q: np.ndarray) -> bool:
+        """Check after substep ``k`` (0-based), state ``q``, when it is a checked one; True ends the step."""
         if not self.active or ((k + 1) % self.every and k + 1 < self.n):
             return False
         w, sim = self.watch, self.sim
         if self.samples:
-            self._record()
+            self._record(q)
         pts = sim.contacts() if self._need_contacts else []
         fired = None
         for rule in w.rules:
@@ -78,17 +78,16 @@ class Checker:
             return True
         return False
 
-    def _record(self) -> None:
-        sim = self.sim
-        if "time" in self.samples:
-            self.samples["time"].append(sim.time)
-        if "com" in self.samples or "root" in self.samples:
-            pos, orn = sim.link_states(base_only="com" not in self.samples)
-            if "com" in self.samples:
-                m = sim.masses
-                self.samples["com"].append(m @ pos / m.sum())
-            if "root" in self.samples:
-                self.samples["root"].append(np.concatenate([pos[0], orn[0]]))
+    def _record(self, q: np.ndarray) -> None:
+        """Log the recorded quantities of the state ``q`` just integrated: time, the CoM by forward
+        kinematics of ``q``, and the root pose (``q[:7]``)."""
+        smp = self.samples
+        if "time" in smp:
+            smp["time"].append(self.sim.time)
+        if "com" in smp:
+            smp["com"].append(self.sim.com_now(q))
+        if "root" in smp:
+            smp["root"].append(q[:7].copy())
 
     def result(self, failed: bool, reason: str) -> dict[str, Any]:
         """``outcome``, ``reason`` (a failed simulation wins), ``touched``, ``samples``."""

@@ -59,6 +59,15 @@ class ToolkitSPD(SPDBackend):
                   None if tau_ext is None else c(tau_ext, f))
         return self.data.tau
 
+    def solve(self, q: Any, qd: Any, q_target: Any, kp: Any, kd: Any, dt: float,
+              qd_target: Any = None) -> Any:
+        """``torques`` for contiguous float64 arrays, without conversions (the simulator's
+        per-substep path); returns ``data.tau`` ``(n_v,)``."""
+        from toolkit.dynamics.spd import spd_solve
+
+        spd_solve(self.model, self.data, q, qd, q_target, kp, kd, dt, self.method, qd_target)
+        return self.data.tau
+
     def control(self, io: Any, q_target: Any, kp: Any, kd: Any, dt: float, torque_limit: Any,
                 qd_target: Any = None) -> Any:
         """Read the state from ``io`` (a ``BulletBody``), solve, clip, apply; returns the torques.

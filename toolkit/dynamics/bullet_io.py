@@ -12,6 +12,8 @@ empty and joint resets/motor commands corrupt the state, so ``BulletBody`` refus
 
 from __future__ import annotations
 
+import math
+
 from typing import Any
 
 import numpy as np
@@ -63,20 +65,21 @@ class BulletBody:
     def read(self) -> tuple[np.ndarray, np.ndarray]:
         """Current ``(q, qd)`` into (and returning) the preallocated ``self.q``, ``self.qd``."""
         pb, b, kw = self.pb, self.body, self._kw
-        qs: list[float] = []
-        vs: list[float] = []
+        states = pb.getJointStatesMultiDof(b, self.joints, **kw)
         if self.floating:
             pos, orn = pb.getBasePositionAndOrientation(b, **kw)
             lin, ang = pb.getBaseVelocity(b, **kw)
-            qs.extend(pos)
-            qs.extend(orn)
-            vs.extend(lin)
-            vs.extend(ang)
-        for s in pb.getJointStatesMultiDof(b, self.joints, **kw):
-            qs.extend(s[0])
-            vs.extend(s[1])
+            qs = [*pos, *orn, *[x for s in states for x in s[0]]]
+            vs = [*lin, *ang, *[x for s in states for x in s[1]]]
+        else:
+            qs = [x for s in states for x in s[0]]
+            vs = [x for s in states for x in s[1]]
         self.q[:] = qs
         self.qd[:] = vs
+        # what the simulator's NaN / explosion check needs, from the Python floats (cheaper than
+        # numpy reductions on arrays this small)
+        self.speed_max = max(map(abs, vs)) if vs else 0.0
+        self.finite = math.isfinite(sum(qs) + sum(vs))
         return self.q, self.qd
 
     def reset(self, q: np.ndarray, qd: np.ndarray) -> None:
@@ -94,16 +97,20 @@ class BulletBody:
             kq += nq
             kv += nv
 
-    def write_torques(self, tau: np.ndarray) -> None:
-        """Apply generalised forces ``(n_v,)`` for the next ``stepSimulation``."""
+    def write_torques(self, tau: np.ndarray) -> bool:
+        """Apply generalised forces ``(n_v,)`` for the next ``stepSimulation``; False (nothing
+        applied) when one of them is NaN or infinite."""
         pb, b, kw = self.pb, self.body, self._kw
         t = tau.tolist()
+        if not math.isfinite(sum(t)):
+            return False
         forces = [t[a:e] for a, e in self._vslices]
         pb.setJointMotorControlMultiDofArray(b, self.joints, pb.TORQUE_CONTROL, forces=forces, **kw)
         if self.floating and any(t[0:6]):
             pos, _ = pb.getBasePositionAndOrientation(b, **kw)
             pb.applyExternalForce(b, -1, t[0:3], pos, pb.WORLD_FRAME, **kw)
             pb.applyExternalTorque(b, -1, t[3:6], pb.WORLD_FRAME, **kw)
+        return True
 
     def stable_pd(self, q_target: np.ndarray, kp: np.ndarray, kd: np.ndarray,
                   torque_limit: np.ndarray, qd_target: np.ndarray | None = None) -> None:

@@ -212,6 +212,12 @@ class RolloutWorker:
             "episodes": episodes, "starts": starts,
         }
 
+    def peak_rss_mb(self) -> float:
+        """Peak resident memory of the process holding this worker (MB)."""
+        import resource
+
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
     def close(self) -> None:
         """Close the environments."""
         for env in self.envs:

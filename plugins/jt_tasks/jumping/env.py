@@ -208,8 +208,8 @@ class JumpEnv(CharacterEnv):
         self._penalties.append(self.penalty)
         self.t = float(rec["time"])
         smp = rec["samples"]
-        for t, com, root in zip(smp["time"], smp["com"], smp["root"]):
-            self.tracker.update(float(t), float(self.suite.past(com)), root[3:7])
+        if len(smp["time"]):
+            self.tracker.update_many(smp["time"], self.suite.past(smp["com"]), smp["root"][:, 3:7])
         mat = rec["touched"].get(self.suite.mat_id)
         if mat is not None and not self.landed:
             self.landed, self.head_first = True, HEAD_LINK in mat

@@ -90,6 +90,29 @@ class CrossingTracker:
         self._prev = (float(t), float(signed_distance), q_root.copy())
         return found
 
+    def update_many(self, times: np.ndarray, signed_distances: np.ndarray, q_roots: np.ndarray) -> bool:
+        """``update`` for each row, in order, in one call: ``times`` ``(k,)``, ``signed_distances``
+        ``(k,)``, ``q_roots`` ``(k, 4)``. Equivalent to the loop, but only the rows around the first
+        crossing are looked at one by one. True when the crossing was found in these rows."""
+        k = len(times)
+        if k == 0:
+            return False
+        if self.crossed:
+            self._prev = (float(times[-1]), float(signed_distances[-1]), np.asarray(q_roots[-1], dtype=float).copy())
+            return False
+        d = np.asarray(signed_distances, dtype=float)
+        before = np.concatenate([[self._prev[1] if self._prev is not None else np.nan], d[:-1]])
+        hits = np.flatnonzero((before < 0.0) & (d >= 0.0))
+        if len(hits) == 0:
+            self._prev = (float(times[-1]), float(d[-1]), np.asarray(q_roots[-1], dtype=float).copy())
+            return False
+        i = int(hits[0])
+        if i > 0:
+            self._prev = (float(times[i - 1]), float(d[i - 1]), np.asarray(q_roots[i - 1], dtype=float).copy())
+        self.update(float(times[i]), float(d[i]), q_roots[i])
+        self._prev = (float(times[-1]), float(d[-1]), np.asarray(q_roots[-1], dtype=float).copy())
+        return True
+
     def stage1(self) -> float:
         """Stage-1 feature (angle to up), NaN before the crossing."""
         return up_angle(self.q_root) if self.q_root is not None else math.nan

@@ -145,7 +145,7 @@ class SimulatorContract:
         assert rec["substeps"] == 8  # checked at 2, 4, 6, 8: t = 8/600 >= 7.5/600
         np.testing.assert_allclose(rec["samples"]["time"], np.arange(2, 9, 2) / 600.0)
         assert rec["samples"]["com"].shape == (4, 3) and rec["samples"]["root"].shape == (4, 7)
-        np.testing.assert_allclose(rec["samples"]["com"][-1], sim.com(), atol=1e-12)
+        np.testing.assert_allclose(rec["samples"]["com"][-1], sim.com(), atol=1e-12)  # the state just integrated
         assert rec["samples"]["com"][0][1] > rec["samples"]["com"][-1][1]  # falling
 
     # ------------------------------------------------------------------ scene, rays

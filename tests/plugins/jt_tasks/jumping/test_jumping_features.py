@@ -52,3 +52,24 @@ def test_stage2_feature_is_independent_of_the_approach_angle():
 def test_angle_distance():
     assert angle_distance([0.2], [3.0]) == pytest.approx(2.8)
     assert float(angle_distance([0.0], [math.pi])) == pytest.approx(math.pi)
+
+
+def test_update_many_equals_update_one_by_one():
+    """The vectorised feed finds the same crossing (time, orientation) as the loop, from any split."""
+    from jt_tasks.jumping.features import CrossingTracker
+
+    rng = np.random.default_rng(3)
+    t = np.arange(40) / 600.0
+    d = np.linspace(-0.2, 0.3, 40) + 0.02 * np.sin(np.arange(40))
+    q = rng.normal(size=(40, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    one = CrossingTracker()
+    for row in zip(t, d, q):
+        one.update(*row)
+    for split in (1, 7, 23, 39):
+        many = CrossingTracker()
+        many.update_many(t[:split], d[:split], q[:split])
+        many.update_many(t[split:], d[split:], q[split:])
+        assert many.crossed == one.crossed and many.time == one.time
+        np.testing.assert_array_equal(many.q_root, one.q_root)
+        assert many._prev[0] == one._prev[0]

@@ -5,6 +5,12 @@ per iteration and the deterministic rollout's trajectory).
 Recorded with ``spd=maba``: before the layer, the tasks' ``task.spd: df`` fallback never fired
 (conf/config.yaml always chose maba), so maba is what ran then; the tasks now choose df through
 their YAML defaults (docs/configuration.md).
+
+One intended change since: the high jump's strategy feature (the root orientation when the CoM
+crosses the bar plane) now takes the CoM of the state just integrated (forward kinematics in the
+simulator's substep loop) instead of PyBullet's cached link frames, which lag one 600 Hz substep
+behind; the crossing is found one substep earlier, moving the feature by ~0.005 rad. Everything
+else — every PPO statistic, the trajectory — is unchanged to the last digit.
 """
 
 from __future__ import annotations
@@ -54,5 +60,8 @@ def test_same_seed_curve_equals_the_recording_before_the_layer(task, tmp_path):
         np.testing.assert_allclose(hist[key], values, rtol=1e-9, atol=1e-12, err_msg=key)
     ro = _tree(art / "rollout.h5")
     for key, values in golden["rollout"].items():
+        if key.startswith("feature_"):  # the crossing is taken one substep earlier (see above)
+            np.testing.assert_allclose(ro[key], values, atol=0.01, err_msg=key)
+            continue
         np.testing.assert_allclose(ro[key], values, rtol=1e-9, atol=1e-12, err_msg=key)
     assert len(golden["history"]["policy_loss"]) == 4  # four PPO iterations were compared

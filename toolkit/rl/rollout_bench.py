@@ -1,0 +1,192 @@
+"""``jt bench rollout``: where a policy task's environment spends its time, and PPO's collection speed.
+
+Two measurements, in one run, on a task's own environment (``Task.make_env``):
+
+* **the env alone**, random actions ``N(0, 0.3²)`` around the action space's centre: control
+  steps per second at each control rate, and per 600 Hz substep the time in PyBullet's
+  ``stepSimulation`` (physics), the SPD solve, state reads and torque writes (I/O), the NaN check
+  and the episode's ``Watch`` (checks), and the rest of the env's Python per control step (env),
+  from the simulator's ``timers``; the physics share is physics over the whole wall time;
+* **PPO collection** with the paper's 1024-512 networks (``PPOConfig`` defaults): samples per
+  second of ``n`` ``RolloutWorker`` s (16 envs each, one batched policy forward per step) in the
+  ``local`` executor's process pool (one worker too: each in a process of its own, as training
+  runs them), with each worker's peak resident memory.
+
+The paper's figure to compare with: Yin et al. 2021 (``000`` §6.2) train one strategy (~1e8
+samples) in "about six hours" on 48 cores: about 96 samples/s per core.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+PAPER_SAMPLES_PER_CORE = 1.0e8 / (6 * 3600) / 48  #: 000 §6.2: ~1e8 samples, ~6 h, 48 cores
+
+
+def _set_control_rate(env: Any, hz: float) -> bool:
+    """Set the env's control rate if it has one the curriculum can set (the jumps)."""
+    if hasattr(env, "control_hz") and hasattr(env, "substeps_now"):
+        env.control_hz = float(hz)
+        return True
+    return False
+
+
+def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps: int = 400,
+                  seed: int = 0) -> dict[str, float]:
+    """Time ``control_steps`` random-action control steps of a fresh env at ``control_hz``.
+
+    Returns:
+        ``control_steps_per_s``, ``substeps``, per-substep ``us_physics``, ``us_spd``, ``us_io``,
+        ``us_checks``, ``us_env``, ``us_total``, and ``physics_share`` (physics / wall).
+    """
+    env = make_env()
+    try:
+        if not _set_control_rate(env, control_hz) and abs(env.sim.params.control_hz - control_hz) > 1e-9:
+            return {}
+        rng = np.random.default_rng(seed)
+        low, high = env.action_space.low, env.action_space.high
+        mid, half = 0.5 * (low + high), 0.5 * (high - low)
+
+        def run(n: int) -> None:
+            env.reset(seed=seed)
+            for _ in range(n):
+                a = np.clip(mid + 0.3 * half * rng.standard_normal(mid.shape), low, high).astype(np.float32)
+                _, _, te, tr, _ = env.step(a)
+                if te or tr:
+                    env.reset()
+
+        run(min(50, control_steps))  # warm up numba and the caches
+        env.sim.reset_timers()
+        t0 = time.perf_counter()
+        run(control_steps)
+        wall = time.perf_counter() - t0
+        tm = env.sim.timers
+        n = max(int(tm["substeps"]), 1)
+        out = {"control_hz": float(control_hz), "control_steps_per_s": control_steps / wall,
+               "substeps": float(n)}
+        phys, spd, io, loop = (tm.get(k, 0.0) for k in ("physics_s", "spd_s", "io_s", "loop_s"))
+        out.update(us_physics=phys / n * 1e6, us_spd=spd / n * 1e6, us_io=io / n * 1e6,
+                   us_checks=max(loop - phys - spd - io, 0.0) / n * 1e6,
+                   us_env=max(wall - loop, 0.0) / n * 1e6, us_total=wall / n * 1e6,
+                   physics_share=phys / wall)
+        return out
+    finally:
+        env.close()
+
+
+def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: int = 16,
+               n_steps: int = 64, executor: Any = None, seed: int = 0) -> dict[str, float]:
+    """PPO collection speed of ``n_workers`` rollout workers with the paper's networks.
+
+    Returns:
+        ``samples_per_s`` (all workers), ``samples_per_s_per_worker``, ``peak_rss_mb`` (the
+        largest worker's peak resident memory).
+    """
+    from toolkit.rl.config import PPOConfig
+    from toolkit.rl.networks import ActorCritic
+    from toolkit.rl.rollout import start_workers
+
+    from toolkit.rl.rollout import RolloutWorker
+
+    cfg = PPOConfig()
+    if executor is not None:  # every worker in its own process, one worker too (as a pool runs them)
+        args = [(env_fn, seed, list(range(w * envs_per_worker, (w + 1) * envs_per_worker)),
+                 tuple(cfg.policy_hidden), tuple(cfg.value_hidden), cfg.normalize_actions, True)
+                for w in range(n_workers)]
+        workers = executor.actors(RolloutWorker, args)
+    else:
+        workers = start_workers(env_fn, seed, n_workers, envs_per_worker, cfg.policy_hidden, cfg.value_hidden,
+                                cfg.normalize_actions, True, None)
+    try:
+        probe = env_fn(seed)
+        obs_dim, act_dim = int(np.prod(probe.observation_space.shape)), int(np.prod(probe.action_space.shape))
+        low, high = probe.action_space.low, probe.action_space.high
+        probe.close()
+        model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions)
+        workers.call("set_weights", [(model.numpy_state(),)] * workers.size)
+        workers.call("collect", [(4, cfg.std_start, 0)] * workers.size)  # warm up
+        t0 = time.perf_counter()
+        workers.call("collect", [(n_steps, cfg.std_start, 1)] * workers.size)
+        wall = time.perf_counter() - t0
+        rss = workers.call("peak_rss_mb", [()] * workers.size)
+    finally:
+        workers.close()
+    total = n_workers * envs_per_worker * n_steps
+    return {"n_workers": float(n_workers), "samples_per_s": total / wall,
+            "samples_per_s_per_worker": total / wall / n_workers, "peak_rss_mb": float(max(rss))}
+
+
+def run_bench(task: str, overrides: list[str], rates: list[float], control_steps: int = 400,
+              n_steps: int = 64, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None) -> dict:
+    """The whole benchmark for one task (see the module docstring); ``echo`` prints progress."""
+    from toolkit import plugins
+    from toolkit.config import compose
+
+    say = echo or (lambda s: None)
+    cfg = compose([f"task={task}", *overrides])
+    t = plugins.load("task", task)(cfg)
+    result: dict[str, Any] = {"task": task, "overrides": overrides, "env": [], "collection": []}
+    for hz in rates:
+        row = env_breakdown(lambda: t.make_env(seed=0), hz, control_steps)
+        if row:
+            result["env"].append(row)
+            say(f"  env at {hz:g} Hz: {row['control_steps_per_s']:.0f} control steps/s, physics share "
+                f"{100 * row['physics_share']:.0f} %")
+    env_fn = _EnvFn(task, overrides)
+    for n in workers:  # rollout workers in the local executor's process pool
+        executor = plugins.load("executor", "local")({"name": "local", "workers": n})
+        try:
+            row = collection(env_fn, n, n_steps=n_steps, executor=executor)
+        finally:
+            executor.close()
+        result["collection"].append(row)
+        say(f"  collection, {n} worker(s): {row['samples_per_s']:.0f} samples/s")
+    col = {int(r["n_workers"]): r for r in result["collection"]}
+    if 1 in col and 2 in col:
+        result["speedup_2_workers"] = col[2]["samples_per_s"] / col[1]["samples_per_s"]
+    if 1 in col:
+        result["ratio_to_paper_per_core"] = col[1]["samples_per_s"] / PAPER_SAMPLES_PER_CORE
+    return result
+
+
+class _EnvFn:
+    """Picklable ``env_fn(seed)`` composing the task in the worker (plugins through the registry)."""
+
+    def __init__(self, task: str, overrides: list[str]) -> None:
+        self.task, self.overrides = task, list(overrides)
+        self._task: Any = None
+
+    def __call__(self, seed: int) -> Any:
+        if self._task is None:
+            from toolkit import plugins
+            from toolkit.config import compose
+
+            self._task = plugins.load("task", self.task)(compose([f"task={self.task}", *self.overrides]))
+        return self._task.make_env(seed=seed)
+
+    def __getstate__(self) -> dict:
+        return {"task": self.task, "overrides": self.overrides, "_task": None}
+
+
+def format_table(res: dict) -> str:
+    """The benchmark as the text table ``jt bench rollout`` prints."""
+    lines = [f"task={res['task']} {' '.join(res['overrides'])}",
+             f"{'control':>8} {'steps/s':>8} {'physics':>8} {'spd':>6} {'io':>6} {'checks':>7} {'env':>6} "
+             f"{'total':>7}  physics share   (µs per 600 Hz substep)"]
+    for r in res["env"]:
+        lines.append(f"{r['control_hz']:>6.0f}Hz {r['control_steps_per_s']:>8.0f} {r['us_physics']:>8.1f} "
+                     f"{r['us_spd']:>6.1f} {r['us_io']:>6.1f} {r['us_checks']:>7.1f} {r['us_env']:>6.1f} "
+                     f"{r['us_total']:>7.1f}  {100 * r['physics_share']:>5.0f} %")
+    for r in res["collection"]:
+        lines.append(f"PPO collection (1024-512 nets, 16 envs/worker), {int(r['n_workers'])} worker(s): "
+                     f"{r['samples_per_s']:.0f} samples/s ({r['samples_per_s_per_worker']:.0f} per worker), "
+                     f"peak RSS per worker {r['peak_rss_mb']:.0f} MB")
+    if "speedup_2_workers" in res:
+        lines.append(f"1 -> 2 workers: {res['speedup_2_workers']:.2f}x")
+    if "ratio_to_paper_per_core" in res:
+        lines.append(f"per core vs the paper's {PAPER_SAMPLES_PER_CORE:.0f} samples/s (000 §6.2: ~1e8 samples, "
+                     f"6 h, 48 cores): {res['ratio_to_paper_per_core']:.2f}x")
+    return "\n".join(lines)
