@@ -22,6 +22,14 @@ class RawActionSpace(DofActionSpace):
         name: str = "raw"
         clip_to_limits: bool = True
         """Targets within the joint limits (URDF revolute ranges; |exp map| <= pi)."""
+        around_start: bool = False
+        """Actions are offsets from the episode's initial pose (target = start + a, exp maps
+        added as 002 §4.2 adds corrections), so a policy's initial mean action (~0) holds the
+        start pose: ours, for small budgets (docs/highjump.md); False: the targets themselves."""
+
+    def __init__(self, cfg: Any = None, character: Any = None) -> None:
+        super().__init__(cfg, character)
+        self._start: np.ndarray | None = None
 
     @property
     def dim(self) -> int:
@@ -29,10 +37,23 @@ class RawActionSpace(DofActionSpace):
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         low, high = self.joint_limits()
+        if self.params.around_start:  # offsets: a full joint range either way
+            span = high - low
+            return -span, span.copy()
         return low.copy(), high.copy()
 
     def reset(self, state: Any = None) -> None:
-        """Nothing to clear: the raw space keeps no state."""
+        """Nothing to clear: the raw space keeps no state but its anchor."""
+
+    def anchor(self, q: np.ndarray) -> None:
+        """Keep the initial pose's joint targets ``(n_dof,)`` (with ``around_start``)."""
+        if self.params.around_start:
+            self._start = self.skeleton.joints_to_dofs(np.asarray(q, dtype=np.float64)[7:])
 
     def targets(self, action: np.ndarray, obs: Any = None) -> np.ndarray:
-        return self.finish(self.check_action(action))
+        a = self.check_action(action)
+        if self.params.around_start:
+            if self._start is None:
+                raise RuntimeError("action=raw with around_start: anchor(q) is called after every reset")
+            a = self._start + a
+        return self.finish(a)

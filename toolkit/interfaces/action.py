@@ -43,3 +43,7 @@ class ActionSpace(Plugin, abc.ABC):
     def penalty(self) -> float:
         """The action space's own reward term for the last step (1.0 = no penalty)."""
         return 1.0
+
+    def anchor(self, q: "np.ndarray") -> None:
+        """The episode's initial configuration ``(n_q,)``, given after every reset (for action
+        spaces relative to it); ignored by default."""

@@ -80,6 +80,7 @@ class CharacterEnv(gymnasium.Env):
         if seed is not None:
             self.np_random, _ = gymnasium.utils.seeding.np_random(int(seed))
         self.setup()
+        self.action_space_.anchor(self.sim.state()[0])
         obs = self.observe()
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=obs.shape, dtype=np.float32)
 
@@ -120,6 +121,7 @@ class CharacterEnv(gymnasium.Env):
         super().reset(seed=seed)
         self.done = False
         info = self.start(options)
+        self.action_space_.anchor(self.sim.state()[0])  # action spaces relative to the start pose
         return self.observe(), info
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict]:

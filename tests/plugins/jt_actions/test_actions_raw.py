@@ -25,3 +25,26 @@ class TestRaw(ActionSpaceContract):
         unclipped = RawActionSpace({"clip_to_limits": False})
         assert unclipped.targets(a)[HUMANOID.dof_slices["right_knee"].start] == 0.3
         assert space.penalty() == 1.0
+
+
+class TestRawAroundStart(ActionSpaceContract):
+    """``around_start``: the action is an offset from the episode's initial pose."""
+
+    def make(self):
+        space = RawActionSpace({"name": "raw", "around_start": True}, HUMANOID)
+        space.anchor(np.concatenate([np.zeros(7), HUMANOID.dofs_to_joints(np.full(28, 0.1))]))
+        return space
+
+    def test_zero_action_holds_the_start_pose(self):
+        space = RawActionSpace({"name": "raw", "around_start": True}, HUMANOID)
+        lo, hi = joint_limits(HUMANOID)
+        start = 0.5 * (lo + hi)  # a pose within every limit
+        start[HUMANOID.dof_slices["right_knee"].start] = -0.5  # a bent knee
+        space.anchor(np.concatenate([np.zeros(7), HUMANOID.dofs_to_joints(start)]))
+        np.testing.assert_allclose(space.targets(np.zeros(28)), start, atol=1e-12)
+        a = np.zeros(28)
+        a[HUMANOID.dof_slices["right_knee"].start] = 0.2
+        assert space.targets(a)[HUMANOID.dof_slices["right_knee"].start] == np.float64(-0.3)
+        low, high = space.bounds()
+        np.testing.assert_allclose(high, -low)  # offsets span a joint range either way
+        assert (high > 0).all()
