@@ -36,7 +36,12 @@ def parse_vary(vary: Sequence[str]) -> list[tuple[str, list[str]]]:
         if "=" not in v or not v.split("=", 1)[1]:
             raise JtError(f"bad --vary '{v}': expected KEY=a,b[,c]")
         key, values = v.split("=", 1)
-        out.append((key.strip(), [s.strip() for s in values.split(",") if s.strip()]))
+        items = [s.strip() for s in values.split(",") if s.strip()]
+        if not items:
+            raise JtError(f"bad --vary '{v}': no values (expected KEY=a,b[,c])")
+        if len(set(items)) != len(items):
+            raise JtError(f"bad --vary '{v}': a value is repeated")
+        out.append((key.strip(), items))
     return out
 
 
@@ -66,9 +71,18 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     keys = [k for k, _ in grid]
     variants = list(itertools.product(*[vals for _, vals in grid]))
     cells = []
+    plain = [o for o in overrides if not o.split("=", 1)[0].lstrip("+~") == "seed"]
     for values in variants:
+        chosen = dict(zip(keys, values))
+        if "seed" in chosen:  # the variant's seed is where its seeds start (it is what it says)
+            try:
+                first = int(chosen.pop("seed"))
+            except ValueError:
+                raise JtError(f"--vary seed=...: seeds are integers, got {dict(zip(keys, values))['seed']!r}") from None
+        else:
+            first = int(base.seed)
         for s in range(seeds):
-            ov = [*overrides, *(f"{k}={v}" for k, v in zip(keys, values)), f"seed={int(base.seed) + s}"]
+            ov = [*plain, *(f"{k}={v}" for k, v in chosen.items()), f"seed={first + s}"]
             cfg = compose(ov)  # check every cell before running any
             cells.append((values, ov, cfg))
     store = Store(store_root(str(base.store)))

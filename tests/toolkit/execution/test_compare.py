@@ -37,3 +37,25 @@ def test_parse_vary_rejects_bad_syntax():
     assert parse_vary(["a=1,2", "b=x"]) == [("a", ["1", "2"]), ("b", ["x"])]
     with pytest.raises(JtError):
         parse_vary(["nokey"])
+
+
+def test_varying_the_seed_runs_what_the_row_says(example_plugin, store_dir):
+    """``--vary seed=5,6``: each row's runs have that seed (compare's own seed offset used to win)."""
+    from toolkit.store.tracking import Store
+
+    res = compare(["task=quadratic", "executor.workers=1", "seed=3", f"store={store_dir}"], ["seed=5,6"], seeds=2)
+    assert [r["variant"] for r in res.rows] == ["seed=5", "seed=6"]
+    store = Store(store_dir)
+    kids = store.get_run(res.run_id).data.tags["jt.compare.runs"].split(",")
+    seeds = [int(store.get_run(k).data.params["seed"]) for k in kids]
+    assert seeds == [5, 6, 6, 7]
+
+
+def test_vary_with_no_or_repeated_values_is_one_line():
+    import pytest
+
+    from toolkit.errors import JtError
+
+    for bad in (["seed=,"], ["spd=df,df"]):
+        with pytest.raises(JtError, match="bad --vary"):
+            parse_vary(bad)
