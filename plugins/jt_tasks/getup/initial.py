@@ -1,0 +1,161 @@
+"""Initial states of the get-up episodes (``003`` §5.2, §5.5).
+
+* ``clip_pose``: a frame of a get-up clip (its first pose starts the clip's own curve, §5.5 "The
+  initial posture of each reference motion is used to initialize the character"; its last frame
+  is a standing pose, §5.2 (ii)), velocities from the clip by central differences, lifted so that
+  no part is below the ground (the clips' feet dip into their floor by a few cm).
+* ``fallen_states``: a seeded passive rag-doll generator (§5.2: "dropping a passive rag-doll
+  model with a prone or supine posture onto the terrain"): the standing pose laid prone or supine
+  with a random heading and random joint perturbations, released above the ground with the PD
+  servos off (kp = 0, a small joint damping), simulated until at rest (every generalised speed
+  below ``rest_speed``) and accepted then; a drop not at rest within ``settle_max`` s is redrawn.
+* ``pick_curve``: a curve whose starting torso angles are within 30° of a state's (§5.2), else
+  the nearest one.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from toolkit.motion import rotations as rot
+
+STYLES = ("prone", "supine")  #: the rag-doll drop postures (003 §5.2)
+CLEARANCE = 0.005  #: m between the lowest point of a start pose and the ground (ours)
+
+
+@functools.lru_cache(maxsize=1)
+def _kinematic_body() -> Any:
+    from toolkit.motion.kinematics import KinematicBody
+    from toolkit.motion.skeletons import HUMANOID
+
+    return KinematicBody(HUMANOID)
+
+
+def lowest_point(q: np.ndarray) -> float:
+    """Lowest height of the humanoid's bounding boxes in pose ``q`` (a kinematic copy, never stepped)."""
+    return _kinematic_body().lowest_point(np.asarray(q, dtype=np.float64))
+
+
+def lift_to_ground(q: np.ndarray, ground: float = 0.0, clearance: float = CLEARANCE) -> np.ndarray:
+    """``q`` moved up or down so that its lowest point is ``clearance`` above ``ground``."""
+    q = np.array(q, dtype=np.float64)
+    q[1] += ground + clearance - lowest_point(q)
+    return q
+
+
+def clip_pose(clip: str, mirrored: bool = False, frame: int = 0, ground: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(q (n_q,), qd (n_dof,))`` of a get-up clip's frame (0: the first, -1: the last),
+    ``toolkit.dynamics`` layout, resting ``CLEARANCE`` above ``ground``."""
+    from jt_tasks.getup.curves import load_getup_clip
+    from jt_tasks.takeoff.state import reference_state
+
+    c = load_getup_clip(clip, mirrored)
+    t = float(c.times[frame])
+    t = min(max(t, 1.0 / 120.0), float(c.times[-1]) - 1.0 / 120.0)  # central differences inside the clip
+    p, r, j, v, w, jv = reference_state(c, t)
+    q = lift_to_ground(np.concatenate([p, r, j]), ground)
+    return q, np.concatenate([v, w, jv])
+
+
+def lay_down(q_stand: np.ndarray, style: str, yaw: float, height: float) -> np.ndarray:
+    """The standing pose ``q_stand`` turned to lie ``prone`` or ``supine`` (about the world z axis of
+    a character facing +x), then turned by ``yaw`` about +y, root at ``height``."""
+    if style not in STYLES:
+        raise ValueError(f"unknown fallen style {style!r}: {', '.join(STYLES)}")
+    q = np.array(q_stand, dtype=np.float64)
+    tilt = rot.quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), (-math.pi / 2) if style == "prone" else (math.pi / 2))
+    turn = rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), float(yaw))
+    q[3:7] = rot.quat_normalize(rot.quat_multiply(turn, rot.quat_multiply(tilt, q[3:7])))
+    q[0], q[1], q[2] = 0.0, float(height), 0.0
+    return q
+
+
+def perturb_joints(q: np.ndarray, rng: np.random.Generator, scale: float) -> np.ndarray:
+    """Joint rotations of ``q`` perturbed by random rotations of up to ``scale`` rad (spherical:
+    a random exp map, revolute: a uniform offset)."""
+    from toolkit.motion.skeletons import HUMANOID, SPHERICAL
+
+    q = np.array(q, dtype=np.float64)
+    joints = q[7:]
+    for j, s in zip(HUMANOID.joints, HUMANOID.q_slices.values()):
+        if j.kind == SPHERICAL:
+            d = rng.uniform(-scale, scale, 3)
+            joints[s] = rot.quat_normalize(rot.quat_multiply(joints[s], rot.quat_from_expmap(d)))
+        else:
+            joints[s] = joints[s] + rng.uniform(-scale, scale)
+    q[7:] = joints
+    return q
+
+
+def passive_groups(sim_groups: dict, kd: float) -> dict:
+    """The simulator groups with the PD servos off (kp = 0) and joint damping ``kd``: a rag-doll."""
+    out = {k: dict(v or {}) for k, v in sim_groups.items()}
+    out["character"] = {**out.get("character", {}), "kp": 0.0, "kd": float(kd),
+                        "joint_kp": {}, "joint_kd": {}}
+    return out
+
+
+def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = STYLES, drop_height: float = 0.6,
+                  perturb: float = 0.3, kd: float = 1.0, settle_max: float = 3.0, rest_speed: float = 0.05,
+                  max_tries: int = 4) -> list[dict]:
+    """``n`` settled rag-doll states on the ground, seeded: ``[{q, qd, style, settle_s}]`` (lists).
+
+    Args:
+        sim_groups: ``{"sim", "spd", "character"}`` plain groups (the env's; PD servos switched off here).
+        n: states wanted; ``seed``: their generator's seed (the same seed gives the same states).
+        styles: drop postures cycled through (``prone``, ``supine``).
+        drop_height: m, root height at release (ours).
+        perturb: rad, joint perturbation of the drop pose (ours).
+        kd: N m s/rad, the rag-doll's joint damping (ours; 0 is frictionless joints).
+        settle_max: s of simulation allowed to come to rest (notes: drops settle within 3 s).
+        rest_speed: at rest when every generalised speed is below this (rad/s, m/s).
+        max_tries: drops per state before the last one is accepted as it is.
+    """
+    from jt_tasks.policy.env import load_simulator
+
+    if n <= 0:
+        return []
+    rng = np.random.default_rng(int(seed))
+    sim = load_simulator(passive_groups(sim_groups, kd))
+    q_stand, _ = clip_pose("getup_facedown", False, frame=-1)
+    out = []
+    try:
+        steps = int(round(settle_max * float(sim.params.control_hz)))
+        for i in range(n):
+            style = styles[i % len(styles)]
+            for attempt in range(max_tries):
+                q0 = perturb_joints(lay_down(q_stand, style, rng.uniform(-math.pi, math.pi), 1.0), rng, perturb)
+                q0 = lift_to_ground(q0, 0.0, drop_height)
+                sim.reset(q0, np.zeros(sim.model.n_v))
+                rest, t = False, 0.0
+                for k in range(steps):
+                    q, qd = sim.state()
+                    rec = sim.step(q)
+                    t = (k + 1) / float(sim.params.control_hz)
+                    if rec["failed"]:
+                        break
+                    if k > 3 and float(np.max(np.abs(rec["qd"]))) < rest_speed:
+                        rest = True
+                        break
+                if rest or attempt == max_tries - 1:
+                    q, qd = sim.state()
+                    out.append({"q": q.tolist(), "qd": qd.tolist(), "style": style, "settle_s": t, "at_rest": rest})
+                    break
+    finally:
+        sim.close()
+    return out
+
+
+def pick_curve(start_angles: np.ndarray, curve_starts: np.ndarray, rng: np.random.Generator,
+               max_deg: float = 30.0) -> int:
+    """Index of a curve whose start torso angles ``(θx, θz)`` are each within ``max_deg`` of
+    ``start_angles`` (``003`` §5.2), uniformly among them; none: the nearest (L1) curve."""
+    d = np.abs(np.asarray(curve_starts, float)[:, 1:] - np.asarray(start_angles, float)[-2:])
+    ok = np.nonzero(np.all(d <= math.radians(max_deg), axis=1))[0]
+    if len(ok):
+        return int(ok[rng.integers(len(ok))])
+    return int(np.argmin(d.sum(axis=1)))
