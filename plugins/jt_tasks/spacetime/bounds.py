@@ -1,0 +1,131 @@
+"""Spacetime bounds (``002`` §3.2 eq 2, §5.1): the difference vector and its per-channel widths.
+
+The state of a character is out of bounds when any channel of the difference vector between it
+and the reference at the same time exceeds that channel's width σ. The humanoid's 22 channels,
+in the authors' order (research notes):
+
+* 0–2 ``com_x``, ``com_y``, ``com_z``: absolute CoM difference per world axis (m);
+* 3 ``root``: shortest-arc angle between the world root quaternions (rad);
+* 4–17 each link's joint (``chest`` ... ``left_wrist``, PyBullet link order): the angle of the
+  local rotation difference (quaternion angle for spherical joints, ``|Δθ|`` for the knees and
+  elbows; the wrists are fixed joints, their channel is always 0) (rad);
+* 18–21 ``ee_right_ankle``, ``ee_left_ankle``, ``ee_right_wrist``, ``ee_left_wrist``: distance
+  between the end effectors (joint origins) of the two characters, each relative to its own
+  ground-projected root in its own heading frame (m).
+
+Widths (002 §5.1): CoM 0.2 m, orientations (root and joints) 0.7 rad, end effectors 0.5 m; a
+width of ``inf`` / ``None`` switches a channel off.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Mapping, Optional
+
+import numpy as np
+
+from toolkit.motion import rotations as rot
+
+COM = ("com_x", "com_y", "com_z")
+ROOT = ("root",)
+END_EFFECTOR_NAMES = ("ee_right_ankle", "ee_left_ankle", "ee_right_wrist", "ee_left_wrist")
+GROUPS = ("com", "orientation", "end_effector")
+
+
+def joint_channels(skeleton: Any) -> tuple[str, ...]:
+    """The joint channels: every link of the skeleton but its root link, in link order."""
+    return tuple(skeleton.links[1:])
+
+
+def channel_names(skeleton: Any) -> tuple[str, ...]:
+    """All 22 channel names, in order."""
+    return COM + ROOT + joint_channels(skeleton) + END_EFFECTOR_NAMES
+
+
+@dataclasses.dataclass(frozen=True)
+class BodyState:
+    """What the bounds compare of one character.
+
+    Attributes:
+        q: pose ``(n_q,)`` (root position, root quaternion x, y, z, w, joints in the quaternion layout).
+        com: whole-body CoM ``(3,)`` (world).
+        ee: end effectors ``(4, 3)``: joint origins relative to the ground-projected root, heading frame.
+    """
+
+    q: np.ndarray
+    com: np.ndarray
+    ee: np.ndarray
+
+
+def difference(skeleton: Any, a: BodyState, b: BodyState) -> np.ndarray:
+    """The 22-channel difference vector ``(n_channels,)`` between two states (all >= 0)."""
+    out = [np.abs(np.asarray(a.com, dtype=float) - np.asarray(b.com, dtype=float))]
+    out.append([float(rot.quat_angle(a.q[3:7], b.q[3:7]))])
+    ja, jb = np.asarray(a.q[7:], dtype=float), np.asarray(b.q[7:], dtype=float)
+    by_name = {j.name: (j, s) for j, s in zip(skeleton.joints, skeleton.q_slices.values())}
+    angles = []
+    for name in joint_channels(skeleton):
+        if name not in by_name:  # a fixed joint (the wrists)
+            angles.append(0.0)
+            continue
+        j, s = by_name[name]
+        angles.append(float(rot.quat_angle(ja[s], jb[s])) if j.kind == "spherical" else abs(float(ja[s][0] - jb[s][0])))
+    out.append(angles)
+    out.append(np.linalg.norm(np.asarray(a.ee, dtype=float) - np.asarray(b.ee, dtype=float), axis=-1))
+    return np.concatenate([np.asarray(x, dtype=float).reshape(-1) for x in out])
+
+
+def _off(value: Any) -> bool:
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isinf(value) and value > 0)
+
+
+def widths(skeleton: Any, com: Any = 0.2, orientation: Any = 0.7, end_effector: Any = 0.5,
+           per_channel: Optional[Mapping[str, Any]] = None) -> np.ndarray:
+    """Per-channel widths ``(n_channels,)`` (``inf``: off) from the group widths and overrides.
+
+    Args:
+        com: m, the three CoM channels (a number, or ``[x, y, z]``).
+        orientation: rad, the root and joint channels.
+        end_effector: m, the four end-effector channels.
+        per_channel: ``{channel or group name: width}`` overriding the above; ``None``/``inf``: off.
+
+    Raises:
+        JtError: a width <= 0 or not a number, an unknown channel name (one line).
+    """
+    from toolkit.errors import JtError
+
+    names = channel_names(skeleton)
+    n_joint = len(joint_channels(skeleton))
+
+    def value(where: str, v: Any) -> float:
+        if _off(v):
+            return math.inf
+        try:
+            x = float(v)
+        except (TypeError, ValueError):
+            raise JtError(f"{where}={v!r}: a bound width must be a number > 0 (null or .inf: off)") from None
+        if not x > 0 or math.isnan(x):
+            raise JtError(f"{where}={v!r}: a bound width must be > 0 (null or .inf switches a channel off)")
+        return x
+
+    com_w = [value("task.com_width", c) for c in (com if isinstance(com, (list, tuple)) else [com] * 3)]
+    if len(com_w) != 3:
+        raise JtError(f"task.com_width={com!r}: one width or three (x, y, z)")
+    w = np.array(com_w + [value("task.orientation_width", orientation)] * (1 + n_joint)
+                 + [value("task.end_effector_width", end_effector)] * 4)
+    groups = {"com": range(0, 3), "orientation": range(3, 4 + n_joint), "end_effector": range(4 + n_joint, len(names))}
+    for key, v in dict(per_channel or {}).items():
+        key = str(key)
+        if key in groups:
+            w[list(groups[key])] = value(f"task.widths.{key}", v)
+        elif key in names:
+            w[names.index(key)] = value(f"task.widths.{key}", v)
+        else:
+            raise JtError(f"task.widths.{key}: unknown bound channel; one of: {', '.join(GROUPS + names)}")
+    return w
+
+
+def violations(d: np.ndarray, w: np.ndarray, names: tuple[str, ...]) -> list[str]:
+    """Names of the channels with ``d > w``."""
+    return [names[i] for i in np.flatnonzero(np.asarray(d) > np.asarray(w))]

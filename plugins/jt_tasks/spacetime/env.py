@@ -1,0 +1,222 @@
+"""The spacetime-bounds environment (``gymnasium.Env``): track a clip inside its bounds (``002``).
+
+* Reference state initialisation: an episode starts in the reference state at a phase drawn
+  uniformly from ``[0, 1)`` with the env's ``np_random`` (``reset(options={"phase": φ})`` or the
+  spec's ``init_phase`` fixes it), clip time ``t0 = φ T``.
+* Action (``action=ffc_fbc``, 002 §4.2): the PD target is the reference pose at the control
+  step's phase (the action space's feed-forward controller, fed the phase here) plus the policy's
+  correction; held over the control step's substeps (600 Hz / 30 Hz).
+* ``termination: bounds`` (002 §3.2 eq 2, §5.1): after every control step the 22-channel difference
+  between the character and the reference at the same clip time (``bounds.difference``) is
+  compared with the widths; a channel out of bounds ends the episode with reward 0; otherwise the
+  reward is 1 times the product of the style terms (none: 1). No contact rule.
+* ``termination: contact`` (the DeepMimic baseline of 002 Table 1): a ground contact of a link not
+  allowed for the clip ends the episode with reward 0; otherwise DeepMimic's imitation reward
+  (``jt_tasks.runup.reward.imitation_terms``).
+* An episode is truncated (bootstrapped) at ``time_limit`` (20 s, 002 §5.1), or, for a
+  non-looping clip, ``hold_s`` after the clip's end (the clip holds its last frame).
+* Evaluation (``reset(options={"evaluate": True})``, 002 Table 1): bounds off, only a forbidden
+  ground contact (``eval_allowed``) ends the episode, truncated at ``eval_time_limit``; reward 1
+  per control step; ``info["survival_s"]`` is the episode's length.
+
+Observation ``(obs_dim,)`` float32 (after the authors' 197-D one, research notes): the clip phase,
+root height, the base's and every link's centre of mass relative to the ground-projected root and
+their orientations, in the heading frame, the root's linear and angular velocity in the heading
+frame and the joint velocities.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Optional
+
+import numpy as np
+
+from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.spacetime import bounds as bd
+from jt_tasks.spacetime.reference import END_EFFECTORS, SpacetimeReference, heading_frame, heading_quat
+from toolkit.interfaces.simulator import ContactRule, Watch
+from toolkit.motion import rotations as rot
+
+
+@dataclasses.dataclass
+class SpacetimeSpec:
+    """Everything a spacetime environment needs, as plain picklable data (``SpacetimeTask.env_spec``)."""
+
+    clip: str = "run"
+    heading_axis: str = "x"
+    loop: Optional[bool] = None
+    ground_clearance: float = 0.0
+    termination: str = "bounds"  # bounds | contact
+    widths: list = dataclasses.field(default_factory=list)  # (n_channels,), inf = off; [] = 002 §5.1
+    time_limit: float = 20.0
+    hold_s: float = 0.5
+    init_phase: Optional[float] = None
+    train_allowed: tuple = (5, 11)  # links allowed on the ground in the contact arm
+    eval_allowed: tuple = (5, 11)  # links allowed on the ground in the evaluation
+    eval_time_limit: float = 20.0
+    style: list = dataclasses.field(default_factory=list)  # [{"name": term, ...params}] (jt.rewards)
+    sim: dict = dataclasses.field(default_factory=dict)
+    action: dict = dataclasses.field(default_factory=lambda: {"name": "ffc_fbc"})
+
+
+class SpacetimeEnv(CharacterEnv):
+    """Track a reference clip inside its spacetime bounds (002 §3.2), or the DeepMimic baseline."""
+
+    def setup(self) -> None:
+        from toolkit import plugins
+
+        spec = self.spec_
+        self.ref = SpacetimeReference(spec.clip, spec.heading_axis, spec.ground_clearance, spec.loop)
+        self.axis = spec.heading_axis
+        self.substeps = int(self.sim.n_substeps)
+        self.control_hz = self.sim_hz / self.substeps
+        self.names = bd.channel_names(self.skeleton)
+        self.widths = np.asarray(spec.widths, dtype=float) if len(spec.widths) else bd.widths(self.skeleton)
+        self.style_terms = [(str(t["name"]), plugins.load("reward", str(t["name"]))(
+            {k: v for k, v in t.items() if k != "name"})) for t in spec.style]
+        self.evaluating = False
+        self._start(0.0 if spec.init_phase is None else float(spec.init_phase))
+
+    # ------------------------------------------------------------------ episode bookkeeping
+    def _rule(self, allowed: tuple) -> tuple:
+        forbidden = [i for i in range(-1, self.n_links) if i not in set(int(a) for a in allowed)]
+        if not forbidden:
+            return ()
+        return (ContactRule(self.sim.ground, "fail", "forbidden ground contact", links=tuple(forbidden)),)
+
+    def _start(self, phase: float, evaluate: bool = False) -> None:
+        spec = self.spec_
+        self.evaluating = bool(evaluate)
+        self.phase0 = float(phase)
+        self.t0 = self.phase0 * self.ref.period
+        ref = self.ref.sample(self.t0)
+        self.sim.reset(ref.q, ref.qd)
+        if hasattr(self.action_space_, "reset"):
+            self.action_space_.reset(ref.phase)
+        if evaluate:
+            limit, rules = float(spec.eval_time_limit), self._rule(tuple(spec.eval_allowed))
+        else:
+            limit = float(spec.time_limit)
+            if not self.ref.loop:
+                limit = min(limit, self.ref.period + float(spec.hold_s) - self.t0)
+            rules = self._rule(tuple(spec.train_allowed)) if spec.termination == "contact" else ()
+        self.limit = max(limit, 1.0 / self.control_hz)
+        self.watch = Watch(rules=rules, time_limit=self.limit, time_limit_outcome="truncate")
+        self.steps = 0
+        self.reward_sum = 0.0
+        self.last_d = np.zeros(len(self.names))
+
+    @property
+    def t(self) -> float:
+        """Time since the episode start (s)."""
+        return float(self.sim.time)
+
+    @property
+    def clip_time(self) -> float:
+        """Reference clip time of the current state (s)."""
+        return self.t0 + self.t
+
+    def body_state(self) -> bd.BodyState:
+        """What the bounds compare of the simulated character now."""
+        q, _ = self.sim.state()
+        ee = np.array([self.sim.link_pose(i)[0] for i in END_EFFECTORS])
+        return bd.BodyState(q, np.asarray(self.sim.com(), dtype=float), heading_frame(q, ee, self.axis))
+
+    def difference(self) -> np.ndarray:
+        """The 22-channel difference vector to the reference now."""
+        ref = self.ref.sample(self.clip_time)
+        return bd.difference(self.skeleton, self.body_state(), bd.BodyState(ref.q, ref.com, ref.ee))
+
+    # ------------------------------------------------------------------ gymnasium hooks
+    def start(self, options: Optional[dict]) -> dict:
+        options = options or {}
+        if options.get("phase") is not None:
+            phase = float(options["phase"])
+        elif self.spec_.init_phase is not None:
+            phase = float(self.spec_.init_phase)
+        else:
+            phase = float(self.np_random.uniform(0.0, 1.0))
+        self._start(phase, bool(options.get("evaluate", False)))
+        return {"start_phase": self.phase0}
+
+    def pd_targets(self, action: np.ndarray) -> np.ndarray:
+        if hasattr(self.action_space_, "set_phase"):  # the FFC's phase: this control step's
+            self.action_space_.set_phase(self.ref.phase(self.clip_time))
+        return super().pd_targets(action)
+
+    def observe(self) -> np.ndarray:
+        q, qd = self.sim.state()
+        pos, orn = self.sim.link_states()
+        hq = heading_quat(q[3:7], self.axis)
+        inv = rot.quat_conjugate(hq)
+        rel = heading_frame(q, pos, self.axis)
+        orn_h = rot.quat_canonical(rot.quat_multiply(np.broadcast_to(inv, orn.shape), orn))
+        parts = [[self.ref.phase(self.clip_time), q[1]], rel.reshape(-1), orn_h.reshape(-1),
+                 rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6]), qd[6:]]
+        obs = np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts])
+        return np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
+
+    def style_reward(self, q: np.ndarray, qd: np.ndarray) -> float:
+        """Product of the style terms (1 without any)."""
+        if not self.style_terms:
+            return 1.0
+        pos, _ = self.sim.link_states()
+        joints = np.array([self.sim.link_pose(i)[0] for i in range(-1, self.n_links)])
+        record = {"q": q, "qd": qd, "link_pos": pos, "joint_pos": joints, "masses": self.masses,
+                  "sim": self.sim}
+        out = 1.0
+        for _, term in self.style_terms:
+            out *= float(term(record))
+        return out
+
+    def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        self.steps += 1
+        outcome, reason = rec["outcome"], ""
+        reward, terminated, truncated = 0.0, False, False
+        if rec["failed"]:
+            terminated, reason = True, f"simulator: {rec['reason']}"
+        elif self.evaluating:
+            reward = 1.0
+            terminated, truncated = outcome == "fail", outcome == "truncate"
+            reason = rec["reason"] if outcome else ""
+        elif self.spec_.termination == "bounds":
+            self.last_d = d = self.difference()
+            out = bd.violations(d, self.widths, self.names)
+            if out:
+                terminated, reason = True, "out of bounds: " + ",".join(out)
+            else:
+                q, qd = self.sim.state()
+                reward = self.style_reward(q, qd)
+                truncated = outcome == "truncate"
+                reason = rec["reason"] if truncated else ""
+        else:
+            if outcome == "fail":
+                terminated, reason = True, rec["reason"]
+            else:
+                reward = self.imitation()
+                truncated = outcome == "truncate"
+                reason = rec["reason"] if truncated else ""
+        self.reward_sum += reward
+        if not (terminated or truncated):
+            return float(reward), False, False, {}
+        info = {"reason": reason, "survival_s": self.t, "episode_time": self.t, "steps": float(self.steps),
+                "start_phase": self.phase0, "fell": float(terminated), "time_out": float(truncated)}
+        if reason.startswith("out of bounds"):
+            for name in reason[len("out of bounds: "):].split(","):
+                info[f"out_{name}"] = 1.0
+        return float(reward), terminated, truncated, info
+
+    def imitation(self) -> float:
+        """DeepMimic's imitation reward (Peng et al. 2018 §6) of the current state vs the reference."""
+        from jt_tasks.runup.reward import imitation_terms
+
+        q, qd = self.sim.state()
+        ref = self.ref.sample(self.clip_time)
+        me = self.body_state()
+        return float(imitation_terms(self.skeleton, q, qd, me.ee, me.com, ref.q, ref.qd, ref.ee, ref.com)["imitation"])
+
+    def close(self) -> None:
+        self.ref = None
+        super().close()

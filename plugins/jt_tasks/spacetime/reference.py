@@ -1,0 +1,190 @@
+"""The reference motion of ``task=spacetime``: any DeepMimic humanoid clip, sampled at any time.
+
+``SpacetimeReference`` reads a clip of ``pybullet_data`` (``humanoid3d_<name>.txt``) or a path and
+answers, at any clip time ``t`` (``sample``) or phase (``at_phase``):
+
+* the pose ``q`` (root position, root quaternion, joints; slerp between frames) and the velocities
+  ``qd``: *per-frame* central differences (``toolkit.motion.kinematics.clip_velocities``, whose
+  neighbours across the loop seam come from the previous / next cycle) interpolated linearly
+  between frames, so there is no spike at the seam of a looping clip (research notes, pitfalls);
+* the whole-body CoM (world) and the four end effectors (ankle and wrist joint origins, relative
+  to the ground-projected root, in the root's heading frame), per frame by PyBullet forward
+  kinematics in ``toolkit.motion`` (never imported here), interpolated linearly;
+* a looping clip repeats with the root shifted by ``Clip.cycle_offset()`` (vertical part zeroed)
+  per cycle; a non-looping clip holds its last frame (zero velocities) after its end.
+
+The heading frame turns about +y (y-up world): ``heading_axis`` x (the humanoid's forward axis)
+or z (backflip, roll, crawl: x points up or down during the motion; authors' code).
+
+The clip's feet dip a few cm into the ground in places: the whole reference is lifted by
+``lift`` so that its lowest point over the clip is ``ground_clearance`` above the ground (ours).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from typing import Optional
+
+import numpy as np
+
+from toolkit.motion import rotations as rot
+
+#: end-effector links (PyBullet link index = joint index): right ankle, left ankle, right wrist, left wrist
+END_EFFECTORS = (5, 11, 8, 14)
+HEADING_AXES = {"x": np.array([1.0, 0.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+def resolve_clip(name: str) -> str:
+    """Path of a clip given as a path or a ``pybullet_data`` humanoid motion name (``run``).
+
+    Raises:
+        JtError: no such file (the message lists the shipped humanoid clips).
+    """
+    from toolkit.errors import JtError
+    from toolkit.motion.skeletons import motions_dir
+
+    d = motions_dir()
+    name = str(name)
+    for cand in (name, os.path.join(d, f"humanoid3d_{name}.txt"), os.path.join(d, name),
+                 os.path.join(d, f"{name}.txt")):
+        if os.path.isfile(cand):
+            return cand
+    known = sorted(f[len("humanoid3d_"):-4] for f in os.listdir(d) if f.startswith("humanoid3d_") and f.endswith(".txt"))
+    raise JtError(f"task.clip={name!r}: no such clip; give a path or one of: {', '.join(known)}")
+
+
+def load_humanoid_clip(name: str):
+    """The ``Clip`` of ``name`` (``resolve_clip``); a one-line ``JtError`` for a file that is not a
+    DeepMimic humanoid motion."""
+    from toolkit.errors import JtError
+    from toolkit.motion import ClipError, load_clip
+
+    path = resolve_clip(name)
+    try:
+        clip = load_clip(path, "humanoid")
+    except ClipError as e:
+        raise JtError(f"task.clip={name!r}: not a DeepMimic humanoid motion: {e}") from None
+    return clip
+
+
+def heading_quat(q_root: np.ndarray, axis: str = "x") -> np.ndarray:
+    """Rotation about +y ``(4,)`` that turns the rest direction of the root's ``axis`` into its
+    current direction projected on the ground (y-up world)."""
+    a = HEADING_AXES[axis]
+    f = rot.quat_rotate(np.asarray(q_root, dtype=float), a)
+    yaw = math.atan2(-f[2], f[0]) - math.atan2(-a[2], a[0])
+    return rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), yaw)
+
+
+def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x") -> np.ndarray:
+    """``points (..., 3)`` relative to the ground-projected root ``root_q[:3]`` (height kept), in the
+    root's heading frame."""
+    origin = np.array([root_q[0], 0.0, root_q[2]])
+    inv = rot.quat_conjugate(heading_quat(root_q[3:7], axis))
+    return rot.quat_rotate(inv, np.asarray(points, dtype=float) - origin)
+
+
+@dataclasses.dataclass(frozen=True)
+class RefState:
+    """The reference at one clip time.
+
+    Attributes:
+        q: pose ``(n_q,)``; qd: velocities ``(n_dof,)`` (``toolkit.dynamics`` layout, root world).
+        com: whole-body CoM ``(3,)`` (world); ee: end effectors ``(4, 3)`` in the heading frame.
+        phase: clip phase in ``[0, 1]`` (1 after a non-looping clip's end).
+    """
+
+    q: np.ndarray
+    qd: np.ndarray
+    com: np.ndarray
+    ee: np.ndarray
+    phase: float
+
+
+class SpacetimeReference:
+    """A DeepMimic humanoid clip as a reference motion (see the module docstring).
+
+    Args:
+        clip: a ``pybullet_data`` humanoid clip name or a path.
+        heading_axis: ``x`` or ``z``.
+        ground_clearance: m, the lowest point of the clip after the lift (ours).
+        loop: override the clip's own ``Loop`` flag (None: keep it; every shipped clip wraps).
+    """
+
+    def __init__(self, clip: str = "run", heading_axis: str = "x", ground_clearance: float = 0.0,
+                 loop: Optional[bool] = None) -> None:
+        from toolkit.errors import JtError
+        from toolkit.motion.kinematics import KinematicBody, clip_velocities, forward_kinematics
+
+        if heading_axis not in HEADING_AXES:
+            raise JtError(f"task.heading_axis={heading_axis!r}: x or z")
+        self.clip = load_humanoid_clip(clip)
+        if loop is not None:
+            self.clip = dataclasses.replace(self.clip, loop=bool(loop))
+        self.heading_axis = heading_axis
+        c = self.clip
+        self.skeleton = c.skeleton
+        self.loop = bool(c.loop)
+        self.period = float(c.duration)
+        self.offset = c.cycle_offset()
+        vel = clip_velocities(c)
+        self._vel = np.concatenate([vel.root_lin, vel.root_ang, vel.joints], axis=1)
+        kin = forward_kinematics(c.skeleton, c.root_pos, c.root_rot, c.joints)
+        body = KinematicBody(c.skeleton)
+        try:
+            self.masses = np.asarray(body.masses, dtype=float)
+            low = min(body.lowest_point(np.concatenate([c.root_pos[i], c.root_rot[i], c.joints[i]]))
+                      for i in range(c.n_frames))
+        finally:
+            body.close()
+        self.lift = float(ground_clearance - low)
+        m = self.masses
+        self._com = (m[0] * c.root_pos + np.einsum("l,fld->fd", m[1:], kin.link_com)) / m.sum()
+        self._com[:, 1] += self.lift
+        self._ee = np.stack([heading_frame(np.concatenate([c.root_pos[i], c.root_rot[i]]),
+                                           kin.joint_pos[i, list(END_EFFECTORS)], heading_axis)
+                             for i in range(c.n_frames)])
+        self._ee[:, :, 1] += self.lift
+
+    # ------------------------------------------------------------------ time
+    def phase(self, t: float) -> float:
+        """Clip phase of clip time ``t``: ``(t / T) % 1`` for a loop, ``clip(t / T, 0, 1)`` else."""
+        x = float(t) / self.period
+        return x % 1.0 if self.loop else min(max(x, 0.0), 1.0)
+
+    def _locate(self, t: float) -> tuple[int, int, float, bool]:
+        """``(cycle, frame, fraction, held)`` of clip time ``t``."""
+        T = self.period
+        if self.loop:
+            k = math.floor(t / T)
+            local = t - k * T
+        else:
+            k, local = 0, min(max(t, 0.0), T)
+        times = self.clip.times
+        i = int(np.clip(np.searchsorted(times, local, side="right") - 1, 0, len(times) - 2))
+        frac = float(np.clip((local - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0))
+        return int(k), i, frac, (not self.loop and t > T)
+
+    def sample(self, t: float) -> RefState:
+        """The reference at clip time ``t`` (s; any real number)."""
+        t = float(t)
+        k, i, f, held = self._locate(t)
+        c = self.clip
+        root_pos = (1 - f) * c.root_pos[i] + f * c.root_pos[i + 1] + k * self.offset
+        root_pos = root_pos + np.array([0.0, self.lift, 0.0])
+        root_rot = rot.quat_normalize(rot.quat_slerp(c.root_rot[i], c.root_rot[i + 1], f))
+        a, b = c.joints[i], c.joints[i + 1]
+        joints = (1 - f) * a + f * b
+        for j, s in zip(self.skeleton.joints, self.skeleton.q_slices.values()):
+            if j.kind == "spherical":
+                joints[s] = rot.quat_normalize(rot.quat_slerp(a[s], b[s], f))
+        qd = np.zeros(self._vel.shape[1]) if held else (1 - f) * self._vel[i] + f * self._vel[i + 1]
+        com = (1 - f) * self._com[i] + f * self._com[i + 1] + k * self.offset
+        ee = (1 - f) * self._ee[i] + f * self._ee[i + 1]
+        return RefState(np.concatenate([root_pos, root_rot, joints]), qd, com, ee, self.phase(t))
+
+    def at_phase(self, phase: float, cycle: int = 0) -> RefState:
+        """The reference at ``phase`` of cycle ``cycle``."""
+        return self.sample((float(phase) + int(cycle)) * self.period)

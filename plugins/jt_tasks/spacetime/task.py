@@ -1,0 +1,208 @@
+"""``task=spacetime``: learn a motor skill with spacetime bounds (``002``, Ma et al. 2021).
+
+One evaluation = one motion: PPO (``agent=ppo_spacetime``, 002 §5) on ``SpacetimeEnv`` with the
+FFC + FBC action (``action=ffc_fbc``, 002 §4.2) and reference state initialisation, terminated
+early by the spacetime bounds (``termination: bounds``, 002 §3.2 eq 2, reward 1 times the style
+terms) or, as the DeepMimic baseline of 002 Table 1, by a forbidden ground contact with
+DeepMimic's imitation reward (``termination: contact``). Then the deterministic policy is
+evaluated as in 002 Table 1: bounds off, up to ``eval_time_limit`` (20 s), failing only on a
+forbidden ground contact; the metric is ``survival_s``. docs/spacetime.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any, ClassVar, Optional
+
+import numpy as np
+
+from toolkit.interfaces.task import Evaluation
+
+from jt_tasks.policy.task import PolicyTask
+
+#: the clips whose heading is taken from the root's z axis (authors' code; research notes)
+Z_HEADING = ("backflip", "roll", "crawl")
+FEET = ("right_ankle", "left_ankle")
+HANDS = ("right_wrist", "left_wrist")
+#: links allowed on the ground per clip (research notes: the authors' evaluation); others: the feet
+ALLOWED_CONTACTS: dict[str, Any] = {
+    "cartwheel": FEET + HANDS,
+    "crawl": "all but root, chest, neck",
+    "roll": "all",
+    "getup_facedown": "all",
+    "getup_faceup": "all",
+}
+
+
+def allowed_links(skeleton: Any, clip: str, names: Optional[list] = None) -> tuple[int, ...]:
+    """Link indices allowed on the ground: ``names`` (link names, ``base``; ``["all"]``), else the
+    clip's entry of ``ALLOWED_CONTACTS`` (feet by default)."""
+    links = ["base"] + list(skeleton.links)
+    index = {n: i - 1 for i, n in enumerate(links)}  # base = -1
+    if names is None:
+        entry = ALLOWED_CONTACTS.get(clip, FEET)
+        if entry == "all":
+            names = links
+        elif isinstance(entry, str):  # "all but ..."
+            names = [n for n in links if n not in ("base", "root", "chest", "neck")]
+        else:
+            names = list(entry)
+    elif list(names) == ["all"]:
+        names = links
+    return tuple(sorted(index[str(n)] for n in names))
+
+
+@dataclasses.dataclass
+class SpacetimeConfig:
+    """The ``task`` group of ``task=spacetime`` (every default with its source)."""
+
+    name: str = "spacetime"
+    """Registry name."""
+    clip: str = "run"
+    """Reference motion: a pybullet_data humanoid clip (humanoid3d_<clip>.txt) or a path (002 Table 1 motions; ours: run)."""
+    loop: Optional[bool] = None
+    """Override the clip's Loop flag; null: the file's (every shipped clip wraps; 002 §5: jump and backflip end, ours to choose)."""
+    heading_axis: Optional[str] = None
+    """Root axis whose ground projection is the heading: x or z; null: z for backflip, roll, crawl, else x (authors' code)."""
+    termination: str = "bounds"
+    """Bounds: spacetime-bound early termination (002 §3.2 eq 2); contact: the DeepMimic baseline (002 Table 1)."""
+    com_width: Any = 0.2
+    """M, CoM x/y/z channels, one number or [x, y, z] (002 §5.1; the authors' code: [0.3, 0.2, 0.3])."""
+    orientation_width: Optional[float] = 0.7
+    """Rad, root and joint angle channels (002 §5.1); null: off."""
+    end_effector_width: Optional[float] = 0.5
+    """M, ankle and wrist channels (002 §5.1); null: off."""
+    widths: dict = dataclasses.field(default_factory=dict)
+    """{channel or group (com, orientation, end_effector): width} overrides; null or .inf switches a channel off (002 §5.3.1 style runs)."""
+    time_limit: float = 20.0
+    """S, training episodes are truncated (bootstrapped) here (002 §5.1)."""
+    hold_s: float = 0.5
+    """S, a non-looping clip is extended by holding its last frame this long (authors' code)."""
+    init_phase: Optional[float] = None
+    """Start phase of training episodes; null: uniform over [0, 1) (reference state initialisation, 002 §4.2 / DeepMimic)."""
+    ground_clearance: float = 0.0
+    """M, the reference is lifted so that its lowest point over the clip is this high (ours: the clips dip into the ground)."""
+    style: list = dataclasses.field(default_factory=list)
+    """Style reward terms ([{name: energy, ...}], jt.rewards), multiplied into the reward of 1 (002 §3.3 eqs 4-8)."""
+    eval_phase: float = 0.0
+    """Start phase of the deterministic evaluation (ours)."""
+    eval_time_limit: float = 20.0
+    """S, the evaluation asks for this long without falling (002 Table 1: 20 s)."""
+    allowed_contacts: Optional[list] = None
+    """Link names allowed on the ground in the evaluation and the contact arm (["all"]: any); null: per clip (authors' code: walk feet, cartwheel feet and hands, crawl all but root/chest/neck, roll all)."""
+    filmstrip_frames: int = 4
+    """Frames of the evaluation's filmstrip (ours)."""
+    filmstrip_width: int = 160
+    """Px per frame (ours)."""
+    filmstrip_height: int = 120
+    """Px (ours)."""
+
+    def check(self) -> None:
+        """One-line ``JtError`` for a bad clip, width, channel, heading axis or range."""
+        from toolkit.motion.skeletons import HUMANOID
+        from toolkit.schema import finite, require
+
+        from jt_tasks.spacetime import bounds as bd
+        from jt_tasks.spacetime.reference import load_humanoid_clip
+
+        load_humanoid_clip(self.clip)
+        require(self.heading_axis in (None, "x", "z"), "task.heading_axis", self.heading_axis, "x or z (null: per clip)")
+        require(self.termination in ("bounds", "contact"), "task.termination", self.termination,
+                "bounds (002 §3.2) or contact (the DeepMimic baseline)")
+        com = list(self.com_width) if isinstance(self.com_width, (list, tuple)) else self.com_width
+        bd.widths(HUMANOID, com, self.orientation_width, self.end_effector_width, self.widths)
+        for key in ("time_limit", "hold_s", "eval_time_limit"):
+            v = getattr(self, key)
+            require(finite(v) and (v > 0 or (key == "hold_s" and v >= 0)), f"task.{key}", v, "must be a finite number > 0")
+        for key in ("init_phase", "eval_phase"):
+            v = getattr(self, key)
+            require(v is None or (finite(v) and 0.0 <= v <= 1.0), f"task.{key}", v, "a phase in [0, 1]")
+        require(finite(self.ground_clearance), "task.ground_clearance", self.ground_clearance, "a finite number (m)")
+        if self.allowed_contacts is not None:
+            known = {"base", "all", *HUMANOID.links}
+            bad = [n for n in self.allowed_contacts if str(n) not in known]
+            require(not bad, "task.allowed_contacts", bad, f"unknown link(s); links: {', '.join(sorted(known))}")
+        for t in self.style:
+            require(isinstance(t, dict) and "name" in t, "task.style", t, "a list of {name: <jt.rewards term>, ...}")
+        require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
+                "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,
+                                                       self.filmstrip_height), "frames >= 0, sizes > 0")
+
+
+class SpacetimeTask(PolicyTask):
+    """Spacetime bounds (002): PPO inside bounds around a clip, evaluated as 002 Table 1."""
+
+    key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "train_mean_length")
+    Config: ClassVar[type] = SpacetimeConfig
+    env_path: ClassVar[str] = "jt_tasks.spacetime.env:SpacetimeEnv"
+
+    def __init__(self, cfg: Any = None) -> None:
+        super().__init__(cfg)
+        from toolkit import plugins
+
+        for t in self.params.style:  # an unknown term is a one-line error now, not in a worker
+            plugins.load("reward", str(t["name"]))({k: v for k, v in dict(t).items() if k != "name"})
+
+    def heading_axis(self) -> str:
+        p = self.params
+        if p.heading_axis is not None:
+            return str(p.heading_axis)
+        return "z" if Path(str(p.clip)).stem.replace("humanoid3d_", "") in Z_HEADING else "x"
+
+    def env_spec(self, point: dict[str, float]) -> Any:
+        """The ``SpacetimeSpec`` of the task (no searched parameters: ``point`` is unused)."""
+        from toolkit.motion.skeletons import HUMANOID
+
+        from jt_tasks.spacetime import bounds as bd
+        from jt_tasks.spacetime.env import SpacetimeSpec
+        from jt_tasks.spacetime.reference import resolve_clip
+
+        p = self.params
+        sim, action = self.character_groups()
+        if str(action.get("name")) == "ffc_fbc":
+            action["clip"] = resolve_clip(p.clip)  # the FFC plays the task's clip
+        com = list(p.com_width) if isinstance(p.com_width, (list, tuple)) else p.com_width
+        w = bd.widths(HUMANOID, com, p.orientation_width, p.end_effector_width, p.widths)
+        clip = Path(str(p.clip)).stem.replace("humanoid3d_", "")
+        allowed = allowed_links(HUMANOID, clip, None if p.allowed_contacts is None else list(p.allowed_contacts))
+        return SpacetimeSpec(clip=str(p.clip), heading_axis=self.heading_axis(), loop=p.loop,
+                             ground_clearance=float(p.ground_clearance), termination=p.termination,
+                             widths=[float(x) for x in w], time_limit=float(p.time_limit), hold_s=float(p.hold_s),
+                             init_phase=p.init_phase, train_allowed=allowed, eval_allowed=allowed,
+                             eval_time_limit=float(p.eval_time_limit), style=[dict(t) for t in p.style],
+                             sim=sim, action=action)
+
+    # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
+    def final_options(self, env: Any) -> Optional[dict]:
+        return {"phase": float(self.params.eval_phase), "evaluate": True}
+
+    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
+        info = ro["info"]
+        data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))}}
+        attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
+                 "reason": str(info.get("reason", "")), "widths": str(list(spec.widths))}
+        return data, attrs
+
+    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
+        from jt_tasks.policy.train import last_finite, return_curve, samples_axis
+
+        res, info = trained.result, ro["info"]
+        steps = int(ro["steps"])
+        survival = float(info.get("survival_s", steps / 30.0))
+        lengths = res.history.get("mean_length", [])
+        metrics = {
+            "survival_s": survival,
+            "survival_steps": float(steps),
+            "survived": float(bool(info.get("time_out", 0.0))),
+            "mean_return": float(ro["return"]),
+            "train_mean_return": last_finite(res.history.get("mean_return", [])),
+            "train_mean_length": last_finite(lengths),
+            "samples": float(res.samples), "iterations": float(res.iterations),
+            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
+        }
+        metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
+        history = {"mean_return": return_curve(trained),
+                   "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
+        return Evaluation(metrics=metrics, history=history)

@@ -1,0 +1,130 @@
+"""The spacetime env: gymnasium API, RSI, bounds termination, truncation, contact arm, evaluation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spacetime_helpers import make_env
+
+
+@pytest.fixture(scope="module")
+def env():
+    e = make_env(seed=0)
+    yield e
+    e.close()
+
+
+def test_gymnasium_env_checker():
+    from gymnasium.utils.env_checker import check_env
+
+    e = make_env(seed=0, time_limit=0.5)
+    try:
+        check_env(e, skip_render_check=True)
+        assert e.action_space.shape == (28,)
+    finally:
+        e.close()
+
+
+def test_rsi_is_seeded_and_starts_in_the_reference_state(env):
+    phases = [env.reset(seed=s)[1]["start_phase"] for s in range(8)]
+    assert phases == [env.reset(seed=s)[1]["start_phase"] for s in range(8)]
+    assert len(set(phases)) == 8 and all(0.0 <= p < 1.0 for p in phases)
+    env.reset(options={"phase": 0.3})
+    q, qd = env.sim.state()
+    ref = env.ref.at_phase(0.3)
+    np.testing.assert_allclose(q, ref.q, atol=1e-6)
+    np.testing.assert_allclose(qd, ref.qd, atol=1e-6)
+    assert env.action_space_.phase == pytest.approx(0.3)
+    d = env.difference()
+    assert d[:3].max() < 0.01 and d[3:18].max() < 1e-4 and d[18:].max() < 0.02  # interpolated FK: mm
+
+
+def test_out_of_bounds_ends_the_episode_with_reward_zero(env):
+    env.reset(options={"phase": 0.0})
+    rewards, done, info = [], False, {}
+    while not done:
+        _, r, te, tr, info = env.step(np.full(28, 0.8, np.float32))  # a large constant correction
+        rewards.append(r)
+        done = te or tr
+    assert te and not tr and rewards[-1] == 0.0 and all(r == 1.0 for r in rewards[:-1])
+    assert info["reason"].startswith("out of bounds: ")
+    assert any(k.startswith("out_") for k in info)
+    # the channels named are those over their widths
+    names = info["reason"][len("out of bounds: "):].split(",")
+    over = [env.names[i] for i in np.flatnonzero(env.last_d > env.widths)]
+    assert names == over
+
+
+def test_switched_off_bounds_truncate_at_the_time_limit():
+    import math
+
+    e = make_env(seed=0, widths=[math.inf] * 22, time_limit=0.3)
+    try:
+        e.reset(options={"phase": 0.0})
+        n, done = 0, False
+        while not done:
+            _, r, te, tr, info = e.step(np.zeros(28, np.float32))
+            n += 1
+            done = te or tr
+        assert tr and not te and r == 1.0 and n == 9
+        assert info["survival_s"] == pytest.approx(0.3)
+    finally:
+        e.close()
+
+
+def test_a_non_looping_clip_ends_hold_s_after_its_end():
+    import math
+
+    e = make_env(seed=0, clip="jump", loop=False, widths=[math.inf] * 22, hold_s=0.1)
+    try:
+        T = e.ref.period
+        e.reset(options={"phase": 0.9})
+        assert e.limit == pytest.approx(0.1 * T + 0.1)
+    finally:
+        e.close()
+
+
+def test_contact_arm_uses_the_imitation_reward_and_ground_contacts():
+    e = make_env(seed=0, termination="contact")
+    try:
+        e.reset(options={"phase": 0.0})
+        assert e.watch.rules and 5 not in e.watch.rules[0].links and 1 in e.watch.rules[0].links
+        _, r, te, tr, _ = e.step(np.zeros(28, np.float32))
+        assert 0.3 < r < 1.0 and not te  # near the reference: a high imitation reward
+        done, info = False, {}
+        while not done:
+            _, r, te, tr, info = e.step(np.zeros(28, np.float32))
+            done = te or tr
+        assert te and r == 0.0 and info["reason"] == "forbidden ground contact"
+    finally:
+        e.close()
+
+
+def test_evaluation_has_no_bounds_and_fails_only_on_a_forbidden_contact(env):
+    env.reset(options={"phase": 0.0, "evaluate": True})
+    assert env.watch.time_limit == 20.0 and env.watch.rules
+    done, n = False, 0
+    while not done:
+        _, r, te, tr, info = env.step(np.full(28, 0.8, np.float32))
+        n += 1
+        done = te or tr
+        assert r == 1.0
+    assert n > 8  # it went past where the bounds ended the same actions
+    assert info["reason"] in ("forbidden ground contact",) or info["reason"].startswith("simulator")
+    assert info["survival_s"] == pytest.approx(env.t)
+
+
+def test_gymnasium_make_registers_the_task_and_passes_the_jt_checker():
+    import gymnasium
+
+    from toolkit.rl.gym_check import check_gym_env
+
+    env = gymnasium.make("toolkit.gym_envs:jt/spacetime-v0", overrides=["task.time_limit=0.5"], seed=0)
+    try:
+        check_gym_env(env.unwrapped)
+        obs, _ = env.reset(seed=1)
+        assert env.observation_space.contains(obs)
+        assert env.unwrapped.spec_.action["name"] == "ffc_fbc"
+    finally:
+        env.close()

@@ -1,0 +1,63 @@
+"""task=spacetime: composition, its groups, the env spec, one-line config errors."""
+
+from __future__ import annotations
+
+import pytest
+
+from toolkit.errors import JtError
+
+
+def task(*overrides):
+    from toolkit import plugins
+    from toolkit.config import compose
+
+    cfg = compose(["task=spacetime", *overrides])
+    return plugins.load("task", "spacetime")(cfg), cfg
+
+
+def test_composes_with_its_groups_and_every_field_has_a_source():
+    import dataclasses
+
+    from jt_tasks.spacetime.task import SpacetimeConfig
+
+    t, cfg = task()
+    assert cfg.action.name == "ffc_fbc" and cfg.agent.name == "ppo_spacetime" and cfg.spd.name == "df"
+    assert cfg.agent.gamma == 0.95
+    import inspect
+
+    text = inspect.getsource(SpacetimeConfig)
+    for f in dataclasses.fields(SpacetimeConfig):
+        after = text.split(f"    {f.name}:", 1)[1].split("\n", 2)[1].strip()
+        assert after.startswith('"""'), f.name
+        if f.name not in ("name", "filmstrip_frames", "filmstrip_width", "filmstrip_height"):
+            assert "002" in after or "ours" in after or "authors" in after, f.name
+
+
+def test_env_spec_feeds_the_task_clip_to_the_ffc_and_picks_the_heading_axis():
+    t, _ = task("task.clip=backflip")
+    spec = t.env_spec({})
+    assert spec.action["clip"].endswith("humanoid3d_backflip.txt")
+    assert spec.heading_axis == "z" and len(spec.widths) == 22
+    t, _ = task("task.clip=cartwheel", "task.heading_axis=x")
+    spec = t.env_spec({})
+    assert spec.heading_axis == "x" and set(spec.eval_allowed) == {5, 11, 8, 14}
+    t, _ = task("task.clip=roll")
+    assert len(t.env_spec({}).eval_allowed) == 16  # roll: everything may touch
+
+
+@pytest.mark.parametrize("override, match", [
+    ("task.clip=no_such_clip", "no such clip"),
+    (f"task.clip={__file__}", "not a DeepMimic"),
+    ("task.com_width=0", "must be > 0"),
+    ("task.end_effector_width=-0.5", "must be > 0"),
+    ("+task.widths.elbow=0.5", "unknown bound channel"),
+    ("+task.widths.neck=0", "must be > 0"),
+    ("task.heading_axis=y", "x or z"),
+    ("task.termination=falls", "bounds"),
+    ("task.time_limit=0", "> 0"),
+    ("task.allowed_contacts=[hand]", "unknown link"),
+])
+def test_bad_input_is_one_line_error_at_composition(override, match):
+    with pytest.raises(JtError, match=match) as e:
+        task(override)
+    assert "\n" not in str(e.value)
