@@ -107,6 +107,7 @@ class SpacetimeEnv(CharacterEnv):
         self.steps = 0
         self.reward_sum = 0.0
         self.last_d = np.zeros(len(self.names))
+        self._links_now = self._links_prev = self.sim.link_states()[0] if self.style_terms else None
 
     @property
     def t(self) -> float:
@@ -159,13 +160,15 @@ class SpacetimeEnv(CharacterEnv):
         return np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
 
     def style_reward(self, q: np.ndarray, qd: np.ndarray) -> float:
-        """Product of the style terms (1 without any)."""
+        """Product of the style terms (1 without any). Their record: ``link_pos`` / ``link_vel``
+        ``(n_links + 1, 3)`` (centres of mass; velocities by differences over the control step),
+        ``masses``, ``joint_pos`` ``(n_links, 3)`` (joint origins), ``q``, ``qd``."""
         if not self.style_terms:
             return 1.0
-        pos, _ = self.sim.link_states()
-        joints = np.array([self.sim.link_pose(i)[0] for i in range(-1, self.n_links)])
-        record = {"q": q, "qd": qd, "link_pos": pos, "joint_pos": joints, "masses": self.masses,
-                  "sim": self.sim}
+        pos = self._links_now
+        joints = np.array([self.sim.link_pose(i)[0] for i in range(self.n_links)])
+        record = {"q": q, "qd": qd, "link_pos": pos, "link_vel": (pos - self._links_prev) * self.control_hz,
+                  "joint_pos": joints, "masses": self.masses}
         out = 1.0
         for _, term in self.style_terms:
             out *= float(term(record))
@@ -173,6 +176,8 @@ class SpacetimeEnv(CharacterEnv):
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
         self.steps += 1
+        if self.style_terms:
+            self._links_prev, self._links_now = self._links_now, self.sim.link_states()[0]
         outcome, reason = rec["outcome"], ""
         reward, terminated, truncated = 0.0, False, False
         if rec["failed"]:

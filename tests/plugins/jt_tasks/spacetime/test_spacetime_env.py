@@ -128,3 +128,15 @@ def test_gymnasium_make_registers_the_task_and_passes_the_jt_checker():
         assert env.unwrapped.spec_.action["name"] == "ffc_fbc"
     finally:
         env.close()
+
+
+def test_style_terms_multiply_into_the_survival_reward():
+    import math
+
+    e = make_env(seed=0, widths=[math.inf] * 22, style=[{"name": "volume"}, {"name": "energy", "mode": "increase"}])
+    try:
+        e.reset(options={"phase": 0.2})
+        rs = [e.step(np.zeros(28, np.float32))[1] for _ in range(3)]
+        assert all(0.0 <= r < 1.0 for r in rs) and len(set(rs)) > 1
+    finally:
+        e.close()
