@@ -1,0 +1,287 @@
+"""The get-up environment (``003`` §3.3, §5.1-5.3, §5.6): track style curves from a fallen state.
+
+An episode: a feature curve (``curves.FeatureCurve``) and an initial state (``003`` §5.2): the
+curve's clip's first pose, a settled rag-doll state (a curve whose start torso angles are within
+30° of it), or a standing pose (the curve then starts at ``s = 1``, the standing phase). It lasts
+``T + T_stand`` (3 s, §5.6) and ends early (§5.3) when ``r_task < 0.1`` or the head touches the
+ground for more than 300 ms in a row (head contacts count only after ``head_grace`` s when the
+head lies on the floor, or within 15 cm of it, at t = 0: supine clip starts and rag-doll states).
+``info["success"]`` counts fallen starts only (standing starts: ``standing_success``), so the
+terrain curriculum counts get-ups. Control at the simulator's ``control_hz`` (30 Hz,
+§5.6), ``sim_hz / control_hz`` substeps (600 Hz here; 003 simulates at 60 Hz).
+
+Reward per control step: ``r = r_task · r_natural`` (eq 2), the product of the ``reward`` group's
+jt.rewards terms (``conf/reward/getup.yaml``: eqs 4-9 and the action space's eq 3); ``r_task`` is
+the product of all but ``natural_terms``.
+
+Observation ``(obs_dim,)`` float32, ``003`` §3.3 in the heading frame (``features.heading_yaw``):
+link orientations (the base and 15 PyBullet links: 16 × 4, quaternions, w ≥ 0), link positions
+relative to the root (16 × 3), link angular and linear velocities (16 × 3 each; finite differences over the last control step,
+zero after a reset: ours, the simulator gives no link velocities), the features (h, θx, θz), the
+5 × 5 height map (hip height above the ground, 1 m × 1 m), the curve targets at +0/100/200/300 ms
+(4 × 3) and the previous filtered action (``action=cvae``; the previous action for other spaces).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Optional
+
+import numpy as np
+
+from jt_tasks.getup import features as F
+from jt_tasks.getup.curves import FeatureCurve
+from jt_tasks.getup.initial import clip_pose, pick_curve
+from jt_tasks.policy.env import CharacterEnv
+from toolkit.interfaces.simulator import Watch
+from toolkit.motion import rotations as rot
+
+START_KINDS = ("clip", "fallen", "standing")  #: ``info["start_kind"]`` codes 0, 1, 2
+LOOKAHEAD = (0.0, 0.1, 0.2, 0.3)  #: s, curve targets in the state (003 §3.3.2)
+
+
+@dataclasses.dataclass
+class GetupSpec:
+    """Everything a get-up environment needs, as plain picklable data (``GetupConfig`` documents it)."""
+
+    curves: list = dataclasses.field(default_factory=list)  # FeatureCurve.to_dict() each
+    fallen: list = dataclasses.field(default_factory=list)  # initial.fallen_states() entries
+    reward: dict = dataclasses.field(default_factory=dict)  # {"terms": {name: params}}
+    natural_terms: tuple = ("naturalness",)
+    t_stand: float = 3.0
+    p_standing: float = 0.1
+    p_fallen: float = 0.3
+    curve_match_deg: float = 30.0
+    r_task_min: float = 0.1
+    sustain: float = 0.3
+    head_grace: float = 1.0
+    success_height: float = 0.8
+    success_window: float = 1.0
+    heightmap_n: int = 5
+    heightmap_spacing: float = 0.25
+    sim: dict = dataclasses.field(default_factory=dict)
+    action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
+
+
+def joint_rotations(q: np.ndarray) -> np.ndarray:
+    """Each internal joint's rotation relative to its parent ``(12, 4)`` (x, y, z, w); revolute
+    joints as the rotation about their axis."""
+    from toolkit.motion.skeletons import HUMANOID, SPHERICAL
+
+    joints = np.asarray(q, dtype=np.float64)[7:]
+    out = []
+    for j, s in zip(HUMANOID.joints, HUMANOID.q_slices.values()):
+        if j.kind == SPHERICAL:
+            out.append(rot.quat_normalize(joints[s]))
+        else:
+            out.append(rot.quat_from_axis_angle(np.array(j.axis, dtype=np.float64), float(joints[s.start])))
+    return np.stack(out)
+
+
+class GetupEnv(CharacterEnv):
+    """Get up from a fallen state tracking the height and torso-angle curves (003)."""
+
+    def setup(self) -> None:
+        from toolkit import plugins
+
+        spec = self.spec_
+        self.curves = [FeatureCurve.from_dict(c) for c in spec.curves]
+        if not self.curves:
+            raise ValueError("getup: no feature curves")
+        self.curve_starts = np.array([c.start for c in self.curves])
+        self.control_hz = float(self.sim.params.control_hz)
+        self.dt = 1.0 / self.control_hz
+        terms = dict((spec.reward or {}).get("terms") or {})
+        self.terms = {str(k): plugins.load("reward", str(k))(v) for k, v in terms.items()}
+        self.natural = set(spec.natural_terms)
+        q_stand, qd_stand = clip_pose("getup_facedown", False, frame=-1)
+        self.stand_state = (q_stand, np.zeros_like(qd_stand))
+        self.neutral = joint_rotations(q_stand)  # q̂ of eq 9: the clip's final standing pose (ours)
+        self._clip_starts: dict[tuple, tuple] = {}
+        self.terrain_level = 0  # set by the terrain curriculum (flat only so far)
+        self._begin(0, "clip" if self.curves[0].clip else "standing", None)
+
+    # ------------------------------------------------------------------ episodes
+    def _clip_start(self, c: FeatureCurve) -> tuple[np.ndarray, np.ndarray]:
+        key = (c.clip, c.mirrored)
+        if key not in self._clip_starts:
+            self._clip_starts[key] = clip_pose(c.clip, c.mirrored, frame=0)
+        return self._clip_starts[key]
+
+    def _begin(self, curve: int, kind: str, fallen: Optional[int]) -> None:
+        c = self.curves[curve]
+        if kind == "clip":
+            q, qd = self._clip_start(c)
+        elif kind == "fallen":
+            st = self.spec_.fallen[fallen]
+            q, qd = np.asarray(st["q"], float), np.asarray(st["qd"], float)
+        else:
+            q, qd = self.stand_state
+        self.sim.reset(np.array(q), np.array(qd))
+        self.action_space_.reset(None)
+        self.curve_index, self.curve, self.start_kind = curve, c, kind
+        self.t_offset = c.duration if kind == "standing" else 0.0  # standing: s = 1 from the start
+        self.t_end = c.duration + float(self.spec_.t_stand)
+        self.watch = Watch(time_limit=self.t_end - self.t_offset, time_limit_outcome="truncate",
+                           time_limit_reason="time limit")
+        self.low_t = self.head_t = self.stand_t = 0.0
+        self.got_up = False
+        self.log: list[dict[str, float]] = []
+        self.last_action = np.zeros(self.action_space.shape, dtype=np.float64)
+        self._prev_links = None
+        self._m = None
+        self.supine = bool(self.measure()["features"][2] < math.pi / 2)
+        self.head_down_at_start = F.HEAD_LINK in {link for _, link in self.sim.contacts(self.sim.ground)} \
+            or self._head_height() < 0.15
+
+    def _head_height(self) -> float:
+        lo, _ = self.sim.aabb(F.HEAD_LINK)
+        return float(lo[1]) - float(np.min(self.measure()["ground"]))
+
+    @property
+    def t(self) -> float:
+        """Episode time on the curve's clock (s; a standing start begins at ``T``)."""
+        return float(self.sim.time) + self.t_offset
+
+    def start(self, options: Optional[dict]) -> dict:
+        spec, rng = self.spec_, self.np_random
+        opts = dict(options or {})
+        kind, curve, fallen = opts.get("kind"), opts.get("curve"), opts.get("fallen")
+        if isinstance(curve, str):
+            names = [c.name for c in self.curves]
+            curve = names.index(curve) if curve in names else None
+        with_clip = [i for i, c in enumerate(self.curves) if c.clip]
+        if kind is None:
+            u = float(rng.random())
+            if u < spec.p_standing:
+                kind = "standing"
+            elif u < spec.p_standing + spec.p_fallen and spec.fallen:
+                kind = "fallen"
+            else:
+                kind = "clip" if with_clip else ("fallen" if spec.fallen else "standing")
+        if kind == "fallen" and not spec.fallen:
+            kind = "clip" if with_clip else "standing"
+        if kind == "fallen":
+            fallen = int(rng.integers(len(spec.fallen))) if fallen is None else int(fallen)
+            if curve is None:
+                st = spec.fallen[fallen]
+                self.sim.reset(np.asarray(st["q"], float), np.asarray(st["qd"], float))
+                self._m = None
+                angles = self._measure_now()["features"]
+                curve = pick_curve(angles, self.curve_starts, rng, spec.curve_match_deg)
+        if curve is None:
+            pool = with_clip if kind == "clip" else list(range(len(self.curves)))
+            curve = int(pool[int(rng.integers(len(pool)))])
+        if kind == "clip" and not self.curves[int(curve)].clip:
+            kind = "standing"
+        self._begin(int(curve), kind, fallen)
+        return {"curve": float(self.curve_index), "start_kind": float(START_KINDS.index(kind)),
+                "terrain_level": float(self.terrain_level)}
+
+    # ------------------------------------------------------------------ measurements
+    def _measure_now(self) -> dict[str, Any]:
+        return F.measure(self.sim, self.spec_.heightmap_n, self.spec_.heightmap_spacing)
+
+    def measure(self) -> dict[str, Any]:
+        """Features, heading and height map of the current state (cached until the next step)."""
+        if self._m is None:
+            self._m = self._measure_now()
+        return self._m
+
+    def link_velocities(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Link positions, orientations, angular and linear velocities ``(15, ·)`` (world), the
+        velocities by finite differences over the last control step."""
+        pos, orn = self.sim.link_states()
+        if self._prev_links is None:
+            return pos, orn, np.zeros_like(pos), np.zeros_like(pos)
+        p0, o0 = self._prev_links
+        v = (pos - p0) / self.dt
+        w = rot.quat_to_expmap(rot.quat_multiply(orn, rot.quat_conjugate(o0))) / self.dt
+        return pos, orn, w, v
+
+    def targets(self, t: Any) -> np.ndarray:
+        """Curve targets ``(…, 3)`` at episode time(s) ``t``."""
+        return self.curve(t)
+
+    # ------------------------------------------------------------------ gymnasium hooks
+    def pd_targets(self, action: np.ndarray) -> np.ndarray:
+        if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
+            self.action_space_.set_condition(self.targets(self.t))
+        self._prev_links = self.sim.link_states()
+        self.last_action = np.asarray(action, dtype=np.float64).copy()
+        return super().pd_targets(action)
+
+    def observe(self) -> np.ndarray:
+        m = self.measure()
+        pos, orn, w, v = self.link_velocities()
+        R = F.heading_rotation(m["yaw"])
+        hq = rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), m["yaw"])
+        q_local = rot.quat_canonical(rot.quat_multiply(rot.quat_conjugate(hq)[None, :], orn))
+        p_local = (pos - pos[0]) @ R.T
+        targets = self.targets(self.t + np.array(LOOKAHEAD))
+        prev = getattr(self.action_space_, "filtered", None)
+        prev = self.last_action if prev is None else prev
+        parts = [q_local, p_local, w @ R.T, v @ R.T, m["features"], m["heightmap"], targets, prev]
+        return np.concatenate([np.asarray(x, dtype=np.float64).reshape(-1) for x in parts]).astype(np.float32)
+
+    def record_now(self) -> dict[str, Any]:
+        """The reward terms' record of the current state."""
+        m = self.measure()
+        q, _ = self.sim.state()
+        _, _, w, _ = self.link_velocities()
+        tgt, end = self.targets(self.t), self.curve.end
+        h, tx, tz = (float(x) for x in m["features"])
+        return {"h": h, "theta_x": tx, "theta_z": tz, "target_h": float(tgt[0]), "target_theta_x": float(tgt[1]),
+                "target_theta_z": float(tgt[2]), "target_h_end": float(end[0]), "link_ang_vel": w,
+                "joint_rotations": joint_rotations(q), "neutral_rotations": self.neutral,
+                "naturalness": float(min(max(self.penalty, 0.0), 1.0))}
+
+    def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        self._m = None
+        spec = self.spec_
+        if rec["failed"]:
+            return 0.0, True, False, self._final(f"simulator: {rec['reason']}", False)
+        record = self.record_now()
+        values = {k: float(term(record)) for k, term in self.terms.items()}
+        r_task = math.prod(v for k, v in values.items() if k not in self.natural)
+        r = r_task * math.prod(v for k, v in values.items() if k in self.natural)
+        self.low_t = self.low_t + self.dt if r_task < spec.r_task_min else 0.0
+        grace = spec.head_grace if self.head_down_at_start and self.start_kind != "standing" else 0.0
+        head = F.HEAD_LINK in {link for _, link in self.sim.contacts(self.sim.ground)}
+        self.head_t = self.head_t + self.dt if head and self.sim.time > grace else 0.0
+        standing = record["h"] >= spec.success_height * record["target_h_end"]
+        self.stand_t = self.stand_t + self.dt if standing else 0.0
+        self.got_up = self.got_up or standing
+        self.log.append({"r": r, "r_task": r_task, **{f"r_{k}": v for k, v in values.items()},
+                         "h": record["h"], "theta_x": record["theta_x"], "theta_z": record["theta_z"],
+                         "target_h": record["target_h"], "target_theta_x": record["target_theta_x"],
+                         "target_theta_z": record["target_theta_z"], "head_contact": float(head)})
+        reason = ""
+        if self.low_t > spec.sustain + 1e-9:
+            reason = "r_task < 0.1"
+        elif self.head_t > spec.sustain + 1e-9:
+            reason = "head on the floor"
+        if reason:
+            return r, True, False, self._final(reason, False)
+        if rec["outcome"] == "truncate":
+            return r, False, True, self._final("time limit", True)
+        return r, False, False, {}
+
+    def _final(self, reason: str, reached_end: bool) -> dict[str, Any]:
+        spec = self.spec_
+        success = reached_end and self.stand_t >= spec.success_window - 1e-9
+        standing = self.start_kind == "standing"
+        info: dict[str, Any] = {"reason": reason, "success": float(success and not standing),
+                                "got_up": float(self.got_up and not standing),
+                                "standing_success": float(success and standing),
+                                "start_kind": float(START_KINDS.index(self.start_kind)),
+                                "curve": float(self.curve_index), "terrain_level": float(self.terrain_level),
+                                "episode_time": float(self.sim.time), "steps": float(len(self.log))}
+        if self.log:
+            for k in self.log[0]:
+                if k.startswith("r"):
+                    info[f"{k}_mean"] = float(np.mean([row[k] for row in self.log]))
+            info["task_return_rate"] = float(np.sum([row["r_task"] for row in self.log]) /
+                                             max(1.0, (self.t_end - self.t_offset) * self.control_hz))
+        return info
