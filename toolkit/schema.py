@@ -224,6 +224,10 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
             checks.append((group, schema, group))
     for where, schema, group in checks:  # attached to the root now: ${store} etc. resolve
         check_node(where, schema, cfg[group])
+    for group in plugins.KINDS:  # cross-group checks of the chosen plugins (Plugin.check_run)
+        node = cfg.get(group)
+        if node is not None and "name" in node and group != "reward":
+            plugins.load(group, str(node["name"])).check_run(cfg)
     for group, items in by_group.items():  # groups without a schema: plain struct updates
         node = cfg.get(group)
         if node is None or not OmegaConf.is_dict(node):
@@ -246,6 +250,8 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
         OmegaConf.merge(OmegaConf.structured(RunConfig), top)
     except Exception as e:  # noqa: BLE001
         raise _schema_error("config", RunConfig, e) from e
+    if "store" in cfg and not str(cfg.store).strip():
+        raise JtError("store= is empty: give a folder (store=PATH) or leave it out (./artifacts, or $JT_STORE)")
     OmegaConf.set_struct(cfg, True)
     return cfg
 

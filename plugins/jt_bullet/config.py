@@ -59,6 +59,27 @@ class SimConfig:
     root_servo: RootServo = dataclasses.field(default_factory=RootServo)
     """Hand-of-God root gains (tracking experiments, 001 §2.4.1); zero by default."""
 
+    def check(self) -> None:
+        """Rates, gravity and limits make sense (one ``JtError`` line)."""
+        import math
+
+        from toolkit.errors import JtError
+
+        for key in ("sim_hz", "control_hz", "explode_speed", "explode_distance"):
+            v = getattr(self, key)
+            if not (math.isfinite(v) and v > 0):
+                raise JtError(f"sim.{key}={v}: must be a finite number > 0")
+        ratio = self.sim_hz / self.control_hz
+        if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+            raise JtError(f"sim.control_hz={self.control_hz:g}: sim_hz / control_hz must be a whole number "
+                          f">= 1 (sim_hz={self.sim_hz:g}); e.g. 10, 15, 20, 30, 60")
+        if not (math.isfinite(self.gravity) and self.gravity >= 0):
+            raise JtError(f"sim.gravity={self.gravity}: must be >= 0 (m/s^2 along -y)")
+        if not (math.isfinite(self.friction) and self.friction >= 0):
+            raise JtError(f"sim.friction={self.friction}: must be >= 0")
+        if self.solver_iterations < 0:
+            raise JtError(f"sim.solver_iterations={self.solver_iterations}: must be >= 0 (0: PyBullet's default)")
+
 
 @dataclasses.dataclass
 class CharacterConfig:

@@ -70,6 +70,14 @@ def reflect_unit(u: np.ndarray) -> np.ndarray:
     return np.where(v > 1.0, 2.0 - v, v)
 
 
+def check_budget(cfg: Any) -> None:
+    """A searcher config's ``budget`` and ``batch`` are whole numbers >= 1 (one ``JtError`` line)."""
+    for key in ("budget", "batch"):
+        value = getattr(cfg, key, 1)
+        if not isinstance(value, int) or value < 1:
+            raise JtError(f"search.{key}={value}: must be a whole number >= 1")
+
+
 class BudgetedSearcher(Searcher):
     """A searcher with a total evaluation budget and FIFO matching of told to asked points.
 

@@ -23,7 +23,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from jt_searchers.acquisition import ExpectedDiversity, Exploration
-from jt_searchers.base import BudgetedSearcher, seed_int
+from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.distances import resolve
 from jt_searchers.gp import FeatureGP
 from jt_searchers.optimize import maximize_direct, maximize_lbfgsb
@@ -38,6 +38,13 @@ class BDSSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
+
+        def check(self) -> None:
+
+            """budget and batch >= 1 (one JtError line)."""
+
+            check_budget(self)
+
         budget: int = 10
         """Total evaluations incl. initial samples; 000 §7.1.1 reports the first ten."""
         batch: int = 1

@@ -27,7 +27,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from jt_searchers.base import BudgetedSearcher, seed_int
+from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.mo_cmaes import objectives_of
 from jt_searchers.random_search import unit_samples
 
@@ -48,6 +48,13 @@ class BSOOSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
+
+        def check(self) -> None:
+
+            """budget and batch >= 1 (one JtError line)."""
+
+            check_budget(self)
+
         budget: int = 2000
         """Total evaluations, shared evenly by the remaining bins (ours; 004 runs every bin to convergence)."""
         batch: int = 16

@@ -10,7 +10,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from jt_searchers.base import BudgetedSearcher
+from jt_searchers.base import BudgetedSearcher, check_budget
 
 
 def unit_samples(n: int, dim: int, seed: int, method: str = "uniform") -> np.ndarray:
@@ -43,6 +43,13 @@ class RandomSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
+
+        def check(self) -> None:
+
+            """budget and batch >= 1 (one JtError line)."""
+
+            check_budget(self)
+
         budget: int = 10
         """Total evaluations; 000 §7.2.1 compares the first ten samples."""
         batch: int = 1

@@ -18,7 +18,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from jt_searchers.base import BudgetedSearcher, seed_int
+from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.mo_cmaes import (
     Individual,
     StrategyParameters,
@@ -38,6 +38,13 @@ class RMOOSearcher(BudgetedSearcher):
 
     @dataclasses.dataclass
     class Config:
+
+        def check(self) -> None:
+
+            """budget and batch >= 1 (one JtError line)."""
+
+            check_budget(self)
+
         budget: int = 2000
         """Total evaluations (004 runs to convergence; the budget bounds a run)."""
         batch: int = 16

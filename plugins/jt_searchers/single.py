@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from jt_searchers.base import check_budget
+
 import dataclasses
 from typing import Any, Sequence
 
@@ -19,6 +21,13 @@ class SingleSearcher(Searcher):
 
     @dataclasses.dataclass
     class Config:
+
+        def check(self) -> None:
+
+            """budget and batch >= 1 (one JtError line)."""
+
+            check_budget(self)
+
         name: str = "single"
         budget: int = 1
         """Always one evaluation."""

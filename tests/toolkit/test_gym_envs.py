@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-RL_TASKS = ("highjump", "obstacle", "longjump", "runup")
+RL_TASKS = ("highjump", "obstacle", "longjump", "runup", "spacetime", "getup")
 
 
 def test_every_rl_task_is_registered_and_only_those():

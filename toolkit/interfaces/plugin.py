@@ -31,6 +31,12 @@ class Plugin:
     group_schemas: ClassVar[dict[str, type]] = {}
 
     @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """Checks across the groups of a composed run config that only this plugin can make
+        (a task that needs a character, an action space that needs a prior): raise one
+        ``JtError`` line. Runs at composition, before a run opens; the default checks nothing."""
+
+    @classmethod
     def summary(cls) -> str:
         """First line of the class docstring."""
         doc = (cls.__doc__ or "").strip()

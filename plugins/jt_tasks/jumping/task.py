@@ -112,6 +112,22 @@ class JumpConfig:
                                                        self.filmstrip_height), "frames >= 0, sizes > 0")
 
 
+def check_character_and_prior(cfg: Any, task: str) -> None:
+    """``character=humanoid`` (a jump or run-up starts from the DeepMimic humanoid's clips) and a
+    prior for ``action=pvae|cvae``: one ``JtError`` line each."""
+    from toolkit.errors import JtError
+
+    character = str(group_of(group_of(cfg, "character") or {}, "name") or "humanoid")
+    if character != "humanoid":
+        raise JtError(f"task={task} needs character=humanoid (its take-off states come from the DeepMimic "
+                      f"humanoid's clips), got character={character}")
+    action = group_of(cfg, "action")
+    name = str(group_of(action, "name") or "") if action is not None else ""
+    if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
+        raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
+                      f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
+
+
 class JumpTask(PolicyTask):
     """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
 
@@ -120,6 +136,12 @@ class JumpTask(PolicyTask):
     feature_names: ClassVar[tuple[str, ...]] = ("alpha", "omega_x", "omega_z", "v_z")
     Config: ClassVar[type] = JumpConfig
     env_path: ClassVar[str] = "jt_tasks.jumping.env:JumpEnv"
+
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """The jumps need the humanoid (their take-off states come from its clips) and, for the
+        P-VAE / C-VAE action spaces, a trained prior."""
+        check_character_and_prior(cfg, cls.Config().name)
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

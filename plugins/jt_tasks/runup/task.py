@@ -89,6 +89,14 @@ class RunupTask(PolicyTask):
     Config: ClassVar[type] = RunupConfig
     env_path: ClassVar[str] = "jt_tasks.runup.env:RunupEnv"
 
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """The run-up imitates the DeepMimic humanoid's run: character=humanoid (and a prior for
+        the VAE action spaces)."""
+        from jt_tasks.jumping.task import check_character_and_prior
+
+        check_character_and_prior(cfg, "runup")
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         from jt_tasks.runup.reward import GOAL_FEATURES

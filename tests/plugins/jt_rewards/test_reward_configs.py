@@ -22,6 +22,10 @@ ENTRY_POINTS = {
     "safety": "jt_rewards.terms:Safety",
     "naturalness": "jt_rewards.terms:Naturalness",
     "novelty": "jt_rewards.novelty:Novelty",
+    "getup_height": "jt_rewards.getup:GetupHeight",
+    "getup_torso": "jt_rewards.getup:GetupTorso",
+    "getup_velocity": "jt_rewards.getup:GetupVelocity",
+    "getup_pose": "jt_rewards.getup:GetupPose",
 }
 CONFIGS = sorted(p.stem for p in (ROOT / "conf" / "reward").glob("*.yaml"))
 
