@@ -223,6 +223,8 @@ class JumpEnv(CharacterEnv):
         return self._finish(status == "success", "" if status == "success" else reason)
 
     def _finish(self, success: bool, reason: str) -> tuple[float, bool, bool, dict]:
+        if success and not self.tracker.crossed:  # landed reaching over: the feature at the landing
+            self.tracker.land(self.t, self._com_and_links()[2])
         record = self.episode_record(success)
         values = {name: float(term(record)) for name, term in self.terms.items()}
         reward = math.prod(values.values()) if values else float(success)
@@ -231,7 +233,8 @@ class JumpEnv(CharacterEnv):
                     feature_angle=float(self.tracker.stage1()), bar_height=float(self.difficulty),
                     naturalness=record["naturalness"], root_ang_vel_mean=record["root_ang_vel_mean"],
                     head_first_landing=float(record["head_first_landing"]), episode_time=self.t,
-                    control_hz=float(self.control_hz), reason=reason or "success")
+                    control_hz=float(self.control_hz), reason=reason or "success",
+                    crossed_at_landing=float(self.tracker.at_landing))
         return float(reward), True, False, info
 
     def episode_record(self, success: bool) -> dict[str, Any]:

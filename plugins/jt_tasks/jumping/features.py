@@ -66,6 +66,7 @@ class CrossingTracker:
     def reset(self) -> None:
         """Forget the previous episode."""
         self.crossed = False
+        self.at_landing = False
         self.time = math.nan
         self.q_root: Optional[np.ndarray] = None
         self._prev: Optional[tuple[float, float, np.ndarray]] = None
@@ -89,6 +90,15 @@ class CrossingTracker:
                 self.q_root = rot.quat_normalize(rot.quat_slerp(q0, q_root, u))
         self._prev = (float(t), float(signed_distance), q_root.copy())
         return found
+
+    def land(self, t: float, q_root: np.ndarray) -> None:
+        """A successful landing before the CoM reached the plane (a reach over the bar onto the
+        mat): take the crossing here, at the closest approach (ours; the episode ends at the
+        landing, so the CoM never gets to cross)."""
+        if not self.crossed:
+            self.crossed, self.time = True, float(t)
+            self.q_root = rot.quat_normalize(np.asarray(q_root, dtype=float))
+            self.at_landing = True
 
     def update_many(self, times: np.ndarray, signed_distances: np.ndarray, q_roots: np.ndarray) -> bool:
         """``update`` for each row, in order, in one call: ``times`` ``(k,)``, ``signed_distances``

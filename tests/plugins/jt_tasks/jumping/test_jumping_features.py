@@ -73,3 +73,19 @@ def test_update_many_equals_update_one_by_one():
         assert many.crossed == one.crossed and many.time == one.time
         np.testing.assert_array_equal(many.q_root, one.q_root)
         assert many._prev[0] == one._prev[0]
+
+
+def test_a_landing_before_the_crossing_takes_the_feature_there():
+    """A jump that lands on the mat reaching over, with the CoM still short of the plane, gets its
+    feature at the landing instead of none (its strategy is still a strategy)."""
+    from jt_tasks.jumping.features import CrossingTracker
+
+    tr = CrossingTracker()
+    tr.update(0.0, -0.3, np.array([0.0, 0.0, 0.0, 1.0]))
+    tr.update(0.1, -0.1, np.array([0.0, 0.0, 0.0, 1.0]))
+    assert not tr.crossed and math.isnan(tr.stage1())
+    tilt = np.array([np.sin(0.25), 0.0, 0.0, np.cos(0.25)])  # 0.5 rad about x
+    tr.land(0.12, tilt)
+    assert tr.crossed and tr.at_landing and tr.stage1() == pytest.approx(0.5, abs=1e-9)
+    tr.land(0.2, np.array([0.0, 0.0, 0.0, 1.0]))  # only the first counts
+    assert tr.stage1() == pytest.approx(0.5, abs=1e-9)
