@@ -40,6 +40,18 @@ def run_cmd(
 
     ov = list(overrides or [])
     resume = [o.split("=", 1)[1] for o in ov if o.startswith("resume=")]
+    if cfg and not (resume and resume[0] not in ("", "null")):
+        # print what composes (every key typed and range-checked), then say if it cannot run yet
+        from toolkit.errors import JtError
+        from toolkit.schema import run_checks
+
+        conf = compose(ov, run_checks=False)
+        typer.echo(to_yaml(conf), nl=False)
+        try:
+            run_checks(conf)
+        except JtError as e:
+            typer.echo(f"jt: note: this config does not run as it is: {e}", err=True)
+        return
     if resume and resume[0] not in ("", "null"):
         conf = _resume_config(resume[0], ov)
     else:
@@ -75,6 +87,8 @@ def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untype
     store = Store(store_root(stores[0] if stores else None))
     store.get_run(run_id)  # one clear line if the id is unknown
     path = store.workdir(run_id) / "config.yaml"
+    if not path.is_file() and store.is_server:  # a server store, resumed on another machine
+        store.fetch(run_id, "config.yaml", path.parent)
     if not path.is_file():
         raise JtError(f"run {run_id} has no saved config in {store.root}; it cannot be resumed")
     old = OmegaConf.load(path)
@@ -105,9 +119,9 @@ def compare_cmd(
 @app.command("show", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def show_cmd(
     run_id: str = typer.Argument(..., help="Run id."),
-    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH"),
+    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH or store=http://host:port"),
 ) -> None:
-    """Print a run's config, final metrics and artifacts."""
+    """Print a run's config, final metrics and artifacts (a server store's are downloaded)."""
     from toolkit.execution.show import show
 
     typer.echo(show(run_id, _store_arg(overrides)))
@@ -115,15 +129,24 @@ def show_cmd(
 
 @app.command("ui", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def ui_cmd(
-    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH"),
+    overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH or store=http://host:port"),
     port: int = typer.Option(5000, "--port"),
+    open_browser: bool = typer.Option(False, "--open", help="Open a server store's URL in a browser."),
 ) -> None:
-    """Serve the MLflow UI for the store on 127.0.0.1."""
+    """Serve the MLflow UI for the store on 127.0.0.1 (a server store: print its URL)."""
     import subprocess
 
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import Store, is_server_uri, store_root
 
-    store = Store(store_root(_store_arg(overrides)))
+    root = store_root(_store_arg(overrides))
+    if is_server_uri(root):  # the tracking server serves its own UI: nothing to start here
+        typer.echo(f"MLflow UI: {root}  (served by the tracking server)")
+        if open_browser:
+            import webbrowser
+
+            webbrowser.open(str(root))
+        return
+    store = Store(root)
     typer.echo(f"MLflow UI for {store.root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
     cmd = [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", store.uri,
            "--host", "127.0.0.1", "--port", str(port)]
@@ -163,7 +186,7 @@ def _store_arg(overrides: Optional[List[str]]) -> Optional[str]:
         if o.startswith("store="):
             store = o.split("=", 1)[1]
         else:
-            raise JtError(f"unexpected argument '{o}'; only store=PATH is accepted here")
+            raise JtError(f"unexpected argument '{o}'; only store=PATH (or store=http://host:port) is accepted here")
     return store
 
 

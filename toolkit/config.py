@@ -144,13 +144,18 @@ def _preset(parsed: Sequence[Any]) -> list[str]:
     return [f"preset={name}"] if name in group_options("preset") else []
 
 
-def compose(overrides: Sequence[str] = ()) -> Any:
+def compose(overrides: Sequence[str] = (), run_checks: bool = True) -> Any:
     """Compose ``conf/config.yaml`` with ``overrides`` (Hydra syntax), checked and typed.
 
     Hydra composes the defaults lists: the task's own group choices (``override /spd: df`` in
     ``conf/task/<task>.yaml``), then the experiment's per-task preset ``preset/<experiment>_<task>``
     (which may choose groups too), then the command line, which wins. ``group.key=value``
     assignments are applied afterwards on the group typed by its schema (``toolkit.schema``).
+
+    Args:
+        overrides: Hydra overrides.
+        run_checks: also run the chosen plugins' cross-group checks (``Plugin.check_run``); off
+            for ``jt run --cfg``, which prints a config that cannot run yet and says why.
 
     Returns:
         An OmegaConf ``DictConfig``; every group typed by its schema, struct.
@@ -187,7 +192,7 @@ def compose(overrides: Sequence[str] = ()) -> Any:
         raise JtError(f"config: {_one_line(e)}") from e
     finally:
         GlobalHydra.instance().clear()
-    return validate(cfg, deferred)
+    return validate(cfg, deferred, run_checks)
 
 
 def to_yaml(cfg: Any) -> str:

@@ -182,13 +182,22 @@ def _plugin_schema(group: str, node: Any) -> tuple[Optional[type], Optional[type
     return cls, schema if schema is not None and dataclasses.is_dataclass(schema) else None
 
 
-def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
+def run_checks(cfg: Any) -> None:
+    """The chosen plugins' cross-group checks (``Plugin.check_run``) of a validated config."""
+    for group in plugins.KINDS:
+        node = cfg.get(group)
+        if node is not None and "name" in node and group != "reward":
+            plugins.load(group, str(node["name"])).check_run(cfg)
+
+
+def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = (), run_checks_too: bool = True) -> Any:
     """Type every group of a composed config and apply the deferred group overrides.
 
     Args:
         cfg: Hydra's composed DictConfig.
         overrides: ``[(dotted key, value)]`` assignments inside groups (``task.clip``), applied on
             the typed nodes so that an unknown key names the group's valid keys.
+        run_checks_too: also run the chosen plugins' cross-group checks (``run_checks``).
 
     Returns:
         The validated config, struct (reading or setting an unknown key raises).
@@ -224,10 +233,8 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = ()) -> Any:
             checks.append((group, schema, group))
     for where, schema, group in checks:  # attached to the root now: ${store} etc. resolve
         check_node(where, schema, cfg[group])
-    for group in plugins.KINDS:  # cross-group checks of the chosen plugins (Plugin.check_run)
-        node = cfg.get(group)
-        if node is not None and "name" in node and group != "reward":
-            plugins.load(group, str(node["name"])).check_run(cfg)
+    if run_checks_too:  # cross-group checks of the chosen plugins (Plugin.check_run)
+        run_checks(cfg)
     for group, items in by_group.items():  # groups without a schema: plain struct updates
         node = cfg.get(group)
         if node is None or not OmegaConf.is_dict(node):
