@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from action_contract import ActionSpaceContract
+from toolkit.testing.action import ActionSpaceContract
 from jt_actions.cvae import CVAEActionSpace
 from toolkit.errors import JtError
 from toolkit.priors.io import load_prior

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from action_contract import ActionSpaceContract
+from toolkit.testing.action import ActionSpaceContract
 from jt_actions.ffc_fbc import FFCFBCActionSpace, unwrap_expmaps
 from toolkit.errors import JtError
 from toolkit.motion import HUMANOID

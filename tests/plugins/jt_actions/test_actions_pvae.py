@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from action_contract import ActionSpaceContract
+from toolkit.testing.action import ActionSpaceContract
 from jt_actions.base import naturalness
 from jt_actions.pvae import PVAEActionSpace
 from toolkit.errors import JtError

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from action_contract import ActionSpaceContract
+from toolkit.testing.action import ActionSpaceContract
 from jt_actions.raw import RawActionSpace
 from toolkit.motion import HUMANOID
 from toolkit.priors.limits import joint_limits

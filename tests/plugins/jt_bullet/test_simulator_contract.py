@@ -1,12 +1,8 @@
-"""``sim=bullet`` passes the simulator contract suite (``simulator_contract.py``)."""
+"""``sim=bullet`` passes the simulator contract suite (``toolkit.testing.simulator``)."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).parent))
-from simulator_contract import SimulatorContract  # noqa: E402
+from toolkit.testing.simulator import SimulatorContract
 
 
 class TestBulletSimulator(SimulatorContract):

@@ -8,7 +8,7 @@ import pytest
 
 from toolkit.errors import JtError
 
-from curriculum_contract import CurriculumContract, iteration_stats
+from toolkit.testing.curriculum import CurriculumContract, iteration_stats
 from jt_curricula import schedules
 from jt_curricula.bar_height import BarHeightCurriculum, ObstacleWidthCurriculum
 

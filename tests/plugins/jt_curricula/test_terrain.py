@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from curriculum_contract import CurriculumContract
+from toolkit.testing.curriculum import CurriculumContract
 from jt_curricula.terrain import TerrainCurriculum
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jt_rewards.getup import GetupHeight, GetupPose, GetupTorso, GetupVelocity, phase_alpha, rotation_angles
-from reward_contract import RewardTermContract
+from toolkit.testing.reward import RewardTermContract
 
 I4 = [[0.0, 0.0, 0.0, 1.0]] * 3
 RECORD = {"h": 1.0, "target_h": 1.2, "target_h_end": 1.3, "theta_x": 1.5, "theta_z": 1.4,

@@ -11,7 +11,7 @@ from toolkit.errors import JtError
 
 from jt_rewards.distances import angle, quat, resolve, rotvec
 from jt_rewards.novelty import Novelty
-from reward_contract import RewardTermContract
+from toolkit.testing.reward import RewardTermContract
 from toolkit.motion.rotations import quat_angle, quat_from_expmap
 
 HALF_PI = math.pi / 2

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jt_rewards.style import Energy, Volume, hull_volume, kinetic_energy
-from reward_contract import RewardTermContract
+from toolkit.testing.reward import RewardTermContract
 from toolkit.errors import JtError
 
 CUBE = np.array([[x, y, z] for x in (0, 0.5) for y in (0, 0.6) for z in (0, 0.4)], dtype=float)  # 0.12 m³

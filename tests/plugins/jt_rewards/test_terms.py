@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jt_rewards.terms import Naturalness, RootRotation, Safety, TaskComplete, mean_speed
-from reward_contract import RewardTermContract
+from toolkit.testing.reward import RewardTermContract
 
 RECORD = {"success": True, "root_ang_vel_mean": 3.0, "head_first_landing": False, "naturalness": 0.8}
 

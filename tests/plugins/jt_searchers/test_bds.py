@@ -15,7 +15,7 @@ from jt_searchers.distances import euclidean
 from jt_searchers.gp import FeatureGP, matern52
 from jt_searchers.random_search import RandomSearcher
 from jt_tasks.strategy_landscape import StrategyLandscapeTask
-from searcher_contract import SearcherContract, run_batches
+from toolkit.testing.searcher import SearcherContract, run_batches
 
 FAST = {"direct_maxfun": 400, "n_mc": 64, "lbfgs_starts": 4, "gp_restarts": 1}
 

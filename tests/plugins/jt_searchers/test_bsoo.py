@@ -7,7 +7,7 @@ import pytest
 
 from jt_searchers.bsoo import BSOOSearcher, binned_objective
 from jt_tasks.zdt import ZDT1Task
-from searcher_contract import SearcherContract, run_batches
+from toolkit.testing.searcher import SearcherContract, run_batches
 
 
 class TestBSOO(SearcherContract):

@@ -6,7 +6,7 @@ import numpy as np
 
 from jt_searchers.random_search import RandomSearcher, unit_samples
 from jt_tasks.strategy_landscape import StrategyLandscapeTask
-from searcher_contract import SearcherContract, run_batches
+from toolkit.testing.searcher import SearcherContract, run_batches
 
 
 class TestRandomUniform(SearcherContract):

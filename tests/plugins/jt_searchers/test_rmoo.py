@@ -13,7 +13,7 @@ from jt_searchers.mo_cmaes import Individual, StrategyParameters, update_covaria
 from jt_searchers.random_search import RandomSearcher
 from jt_searchers.rmoo import RMOOSearcher
 from jt_tasks.zdt import ZDT1Task
-from searcher_contract import SearcherContract, run_batches
+from toolkit.testing.searcher import SearcherContract, run_batches
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 

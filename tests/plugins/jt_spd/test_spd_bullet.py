@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from spd_backend_suite import DT, SPDBackendSuite, make_world
+from toolkit.testing.spd import DT, SPDBackendSuite, make_world
 
 from jt_spd.bullet import BulletBackend
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from spd_backend_suite import SPDBackendSuite
+from toolkit.testing.spd import SPDBackendSuite
 
 from jt_spd.pcg import PCGBackend
 
@@ -13,7 +13,7 @@ class TestPCGBackend(SPDBackendSuite):
     def test_tolerance_from_config_sets_the_work_done(self):
         import numpy as np
         import pybullet as pb
-        from spd_backend_suite import DT, make_world
+        from toolkit.testing.spd import DT, make_world
 
         c, ch, _ = make_world("snake36")
         try:

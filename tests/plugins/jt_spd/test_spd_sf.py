@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from spd_backend_suite import SPDBackendSuite
+from toolkit.testing.spd import SPDBackendSuite
 
 from jt_spd.sf import SparseBackend
 

@@ -2,15 +2,10 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from task_contract import TaskContract  # noqa: E402
-
-from toolkit import plugins  # noqa: E402
+from toolkit import plugins
+from toolkit.testing.task import TaskContract
 
 BUILTIN_TASKS = sorted(i.name for i in plugins.available("task") if i.dist == "jt")
 NEEDS = {"pose_prior": ("action=pvae",)}  #: what a task needs to run at all (which prior to train)

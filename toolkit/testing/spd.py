@@ -1,7 +1,15 @@
 """Shared test suite every SPD backend's test module subclasses (Hydra-style test base class).
 
 A subclass sets ``backend_cls`` (and ``reference_exact``: whether its torques must equal exact
-SPD from ``toolkit.dynamics``) and inherits every test.
+SPD from ``toolkit.dynamics``) and inherits every test::
+
+    from toolkit.testing.spd import SPDBackendSuite
+
+    class TestMyBackend(SPDBackendSuite):
+        backend_cls = MyBackend
+
+The worlds are PyBullet bodies of jt's built-in characters (``jt_bullet.characters``, imported
+when a test builds one); ``make()`` builds the backend (``backend_cls(None)`` by default).
 """
 
 from __future__ import annotations
@@ -120,3 +128,7 @@ class SPDBackendSuite:
         q = np.zeros(7)
         with pytest.raises((RuntimeError, NotImplementedError)):
             backend.torques(q, np.zeros(6), q, np.zeros(6), np.zeros(6), DT)
+
+
+#: the same suite under the name the other kinds use
+SPDBackendContract = SPDBackendSuite

@@ -2,7 +2,14 @@
 
 A subclass sets ``cls`` (the term class), ``entry`` (its registry name), ``record`` (a complete,
 valid record), ``required`` (the record keys the term needs with its default config) and ``cases``
-(``(params, record, expected)`` triples, hand-computed).
+(``(params, record, expected)`` triples, hand-computed)::
+
+    from toolkit.testing.reward import RewardTermContract
+
+    class TestUpright(RewardTermContract):
+        cls, entry = Upright, "upright"
+        record, required = {"up": 1.0}, ("up",)
+        cases = [({}, {"up": 0.5}, 0.5)]
 """
 
 from __future__ import annotations

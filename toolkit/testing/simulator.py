@@ -3,7 +3,14 @@ searcher suites: stepping and time, the substep loop's termination rules (``Watc
 reads, contacts, scene geometry (boxes, heightfields), rays and rendering — on the real engine.
 
 A subclass sets ``make()`` (a simulator of the humanoid with 600 Hz substeps) and inherits the
-tests. States come from the DeepMimic run clip (``standing``: a mid-support frame, feet down).
+tests. States come from the DeepMimic run clip (``standing``: a mid-support frame, feet down)::
+
+    from toolkit.testing.simulator import SimulatorContract
+
+    class TestMySim(SimulatorContract):
+        def make(self, **sim):
+            return MySimulator({"sim": {"name": "mine", **sim}, "spd": {"name": "df"},
+                                "character": {"name": "humanoid"}})
 """
 
 from __future__ import annotations

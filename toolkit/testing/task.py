@@ -3,7 +3,13 @@ what ``jt run ... --cfg`` prints, its smoke preset runs end to end and leaves it
 the same seed gives the same metrics.
 
 A subclass sets ``task`` (the registry name) and, if needed, ``overrides`` (what the task needs to
-run at all, e.g. ``action=pvae`` for the prior trainer).
+run at all, e.g. ``action=pvae`` for the prior trainer) and ``plugin_path`` (where a third-party
+task's distribution is installed, when it is not on the default path)::
+
+    from toolkit.testing.task import TaskContract
+
+    class TestMyTask(TaskContract):
+        task = "mytask"        # needs conf task/mytask.yaml and preset/smoke_mytask.yaml
 """
 
 from __future__ import annotations

@@ -1,7 +1,15 @@
 """The contract every jt curriculum meets; each curriculum's test module subclasses it.
 
-A subclass sets ``cls`` and ``entry`` (registry name, also its conf/curriculum/<entry>.yaml) and
-``stream(n)``: ``n`` synthetic iterations as ``(episodes, scalar stats, samples)``.
+A subclass sets ``cls`` and ``entry`` (registry name, also its ``curriculum/<entry>.yaml`` in a
+config root: jt's ``conf/`` or a ``jt.config`` package the plugin ships) and ``stream(n)``: ``n``
+synthetic iterations as ``(episodes, scalar stats, samples)``. Usage::
+
+    from toolkit.testing.curriculum import CurriculumContract
+
+    class TestMine(CurriculumContract):
+        cls, entry = MyCurriculum, "mine"
+        def stream(self, n):
+            return [([{"success": 1.0}], {"success_rate": 1.0}, 64)] * n
 """
 
 from __future__ import annotations
@@ -16,8 +24,6 @@ import pytest
 from omegaconf import OmegaConf
 
 from toolkit.interfaces.curriculum import Curriculum
-
-ROOT = Path(__file__).parents[3]
 
 
 def iteration_stats(scalars: dict[str, float], episodes: list[dict[str, float]]) -> Any:
@@ -36,6 +42,17 @@ class CurriculumContract:
 
     def make(self, params: Any = None):
         return self.cls(params)
+
+    def yaml_path(self) -> Path:
+        """``curriculum/<entry>.yaml`` in the first config root that has it (jt's ``conf/``, then
+        each ``jt.config`` package)."""
+        from toolkit.config import _group_dirs
+
+        for root in _group_dirs():
+            path = Path(root) / "curriculum" / f"{self.entry}.yaml"
+            if path.is_file():
+                return path
+        raise AssertionError(f"curriculum/{self.entry}.yaml is in no config root")
 
     def stream(self, n: int) -> list[tuple[list[dict], dict[str, float], int]]:  # pragma: no cover
         raise NotImplementedError
@@ -122,8 +139,7 @@ class CurriculumContract:
         defaults (the paper's values, each field documented) are what the plugin receives."""
         from toolkit.config import compose
 
-        path = ROOT / "conf" / "curriculum" / f"{self.entry}.yaml"
-        node = OmegaConf.load(path)
+        node = OmegaConf.load(self.yaml_path())
         assert node.name == self.entry and set(node) == {"name"}
         typed = compose([f"curriculum={self.entry}", "task=zdt1"]).curriculum
         assert typed.name == self.entry

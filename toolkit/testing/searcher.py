@@ -1,29 +1,45 @@
-"""The contract every searcher test class inherits: bounds, batches, budget, determinism, resume.
+"""The contract every searcher passes (``jt.searchers``): bounds, batches, budget, determinism,
+resume, a summary that goes to HDF5.
 
-A subclass sets ``searcher_cls``, ``cfg`` (a dict for the search group), ``batch`` and
-``make_task()``; the test methods here then run against the real task. Golden points (first points
-for seed 0) live in ``golden/<golden_name>.json``; regenerate them with
+Shipped with jt so a third-party searcher is tested by the same suite as the built-ins::
 
-    JT_REGEN_GOLDEN=1 PYTHONPATH=.:plugins python -m pytest tests/plugins/jt_searchers -k golden
+    from toolkit.testing.searcher import SearcherContract
 
-and commit the JSON only when the change of points is intended.
+    class TestMySearcher(SearcherContract):
+        searcher_cls = MySearcher
+        cfg = {"name": "mine", "budget": 12}
+        def make_task(self):
+            return MyTask(None)
+
+A subclass sets ``searcher_cls``, ``cfg`` (a dict for the search group; it must have ``budget``),
+``batch`` (points per ``ask``, 1 by default) and ``make_task()``; the test methods here then run
+against the real task. A searcher may stop before its budget when it has converged: the suite
+accepts that only from a searcher with a ``_converged()`` method that says so.
+
+Golden points (first points for seed 0) are optional: set ``golden_name`` and they are read from
+``golden/<golden_name>.json`` next to the subclass's test module (``golden_dir`` overrides the
+folder); regenerate them with ``JT_REGEN_GOLDEN=1 python -m pytest <tests> -k golden`` and commit
+the JSON only when the change of points is intended.
 """
 
 from __future__ import annotations
 
+import inspect
 import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Optional
 
 import numpy as np
 import pytest
 
-from searcher_loop import eval_seed
 from toolkit.interfaces.task import EvalContext
 
-GOLDEN_DIR = Path(__file__).parent / "golden"
+
+def eval_seed(run_seed: int, index: int) -> int:
+    """Seed of evaluation ``index`` of a run, derived from the run seed."""
+    return int(np.random.SeedSequence([run_seed, index]).generate_state(1)[0])
 
 
 def run_batches(searcher: Any, task: Any, batch: int, seed: int, max_batches: int = 10_000) -> list[tuple[np.ndarray, list]]:
@@ -55,6 +71,8 @@ class SearcherContract:
     golden_name: ClassVar[str] = ""
     golden_points: ClassVar[int] = 6
     golden_atol: ClassVar[float] = 1e-6
+    #: folder of the golden files; None: ``golden/`` next to the subclass's test module
+    golden_dir: ClassVar[Optional[Path]] = None
 
     def make_task(self) -> Any:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -79,7 +97,8 @@ class SearcherContract:
         n = sum(len(X) for X, _ in batches)
         assert s.finished()
         assert n <= self.cfg["budget"]
-        assert n == self.cfg["budget"] or s._converged()
+        converged = getattr(s, "_converged", None)  # a searcher's own stopping rule, if it has one
+        assert n == self.cfg["budget"] or (converged is not None and converged())
         assert s.ask(self.batch).shape == (0, task.problem().space.dim)
 
     def test_same_seed_same_points(self) -> None:
@@ -132,7 +151,8 @@ class SearcherContract:
             pytest.skip("no golden file for this searcher")
         s, task = self.make(seed=0)
         X = np.vstack([X for X, _ in run_batches(s, task, self.batch, seed=0)])[: self.golden_points]
-        path = GOLDEN_DIR / f"{self.golden_name}.json"
+        folder = self.golden_dir or Path(inspect.getfile(type(self))).parent / "golden"
+        path = Path(folder) / f"{self.golden_name}.json"
         if os.environ.get("JT_REGEN_GOLDEN"):
             path.write_text(json.dumps({
                 "searcher": self.searcher_cls.__name__,
@@ -140,7 +160,7 @@ class SearcherContract:
                 "batch": self.batch,
                 "seed": 0,
                 "points": X.tolist(),
-                "regenerate": "JT_REGEN_GOLDEN=1 PYTHONPATH=.:plugins python -m pytest tests/plugins/jt_searchers -k golden",
+                "regenerate": f"JT_REGEN_GOLDEN=1 python -m pytest <tests>/{Path(inspect.getfile(type(self))).name} -k golden",
             }, indent=1) + "\n")
         golden = json.loads(path.read_text())
         assert golden["cfg"] == self.cfg, "config changed: regenerate the golden file"

@@ -2,6 +2,13 @@
 
 A subclass sets ``make()`` (a fresh action space) and may override ``obs(step)`` (what the task
 would pass as ``obs``) and ``prepare(space)`` (set-up after construction, e.g. a condition).
+Targets are checked against the joint limits of jt's humanoid (``toolkit.motion.HUMANOID``)::
+
+    from toolkit.testing.action import ActionSpaceContract
+
+    class TestMyActions(ActionSpaceContract):
+        def make(self):
+            return MyActionSpace({"name": "mine"}, "humanoid")
 """
 
 from __future__ import annotations
