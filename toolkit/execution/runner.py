@@ -142,7 +142,7 @@ def run(cfg: Any) -> RunResult:
                 _close_stale_children(store, run_id, experiment)
             history = History.load(hist_path, names)
             searcher = search_cls(problem, cfg.search, int(cfg.seed))
-            _replay(searcher, history, int(cfg.search.batch))
+            _replay(searcher, history, int(searcher.batch_size))
             if resumed and len(history):
                 _log(f"jt: resumed after {len(history)} completed evaluation(s)")
             executor = exec_cls(cfg.executor)
@@ -181,7 +181,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
     budget = int(cfg.search.budget)
     obj_names = list(problem.objective_names)
     while not searcher.finished() and len(history) < budget:
-        x = np.asarray(searcher.ask(min(int(cfg.search.batch), budget - len(history))), dtype=float)
+        x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
         if len(x) == 0:  # a task with no parameters still has one (empty) point
             break
         b, start = history.n_batches, len(history)

@@ -14,10 +14,26 @@ if TYPE_CHECKING:  # pragma: no cover
 class ActionSpace(Plugin, abc.ABC):
     """Maps a policy's action vector to PD targets, once per control step.
 
+    Required: ``dim``, ``bounds``, ``reset``, ``targets``. Optional, with defaults: ``penalty``
+    (1.0), ``anchor`` (ignored), ``skeleton`` (None), ``filtered`` (None). Tasks also call these
+    hooks when an action space has them (looked up with ``hasattr``, so there is no default):
+    ``set_phase(phase)`` (the reference clip's phase this control step, ``task=spacetime``),
+    ``set_condition(c)`` (a C-VAE's condition, ``task=getup``), ``set_c_offset(value)`` and the
+    attribute ``c_offset`` (a P-VAE's offset scale that a curriculum anneals, the jump tasks).
+
+    Attributes:
+        skeleton: the skeleton the targets are for (``toolkit.motion``: joint order, limits);
+            the policy tasks read it, so an action space used by them sets it. None by default.
+        filtered: the action after the space's own filter (the previous step's, fed back into
+            ``task=getup``'s observation), or None (default: the task uses the raw action).
+
     Args:
         cfg: the ``action`` config group, validated against ``Config``.
         character: the character description the targets are for.
     """
+
+    skeleton: Any = None
+    filtered: Any = None
 
     def __init__(self, cfg: Any, character: Any = None) -> None:
         self.cfg = cfg

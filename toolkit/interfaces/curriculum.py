@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import abc
-from typing import Any
+from typing import Any, ClassVar
 
 from toolkit.interfaces.plugin import Plugin
 
@@ -11,9 +11,20 @@ from toolkit.interfaces.plugin import Plugin
 class Curriculum(Plugin, abc.ABC):
     """Holds a difficulty state and updates it from episode outcomes.
 
+    Required: ``update``, ``state``, ``load_state``. What the policy tasks call, with defaults:
+    ``bind(extra)`` (keep the state in the trainer's checkpointed dict), ``on_iteration(...)``
+    (the PPO trainer's per-iteration hook: episodes to ``update``, state back into ``extra``,
+    returns ``env_attrs()``) and ``env_attrs()`` (none). ``jt_curricula.base.IterationCurriculum``
+    is the fuller base the built-ins use.
+
+    Attributes:
+        extra_key: key of this curriculum's state inside the trainer's ``extra`` dict.
+
     Args:
         cfg: the ``curriculum`` config group, validated against ``Config``.
     """
+
+    extra_key: ClassVar[str] = "curriculum"
 
     def __init__(self, cfg: Any = None) -> None:
         self.cfg = cfg
@@ -29,3 +40,34 @@ class Curriculum(Plugin, abc.ABC):
     @abc.abstractmethod
     def load_state(self, state: dict[str, float]) -> None:
         """Restore a saved ``state()``."""
+
+    def env_attrs(self) -> dict[str, Any]:
+        """Attributes to set on every environment for the current difficulty (none by default)."""
+        return {}
+
+    def bind(self, extra: dict[str, Any]) -> dict[str, Any]:
+        """Keep this curriculum's state in ``extra[extra_key]`` (the trainer's checkpointed dict);
+        on resume the trainer refills ``extra`` in place and the next ``on_iteration`` loads it.
+
+        Returns:
+            ``extra`` itself, holding the current ``state()`` unless it already holds a saved one.
+        """
+        self._bound_extra = extra
+        self._bound_synced = False
+        extra.setdefault(self.extra_key, dict(self.state()))
+        return extra
+
+    def on_iteration(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
+        """The PPO trainer's hook after each iteration: every finished episode of ``stats.episodes``
+        goes to ``update``; returns ``env_attrs()`` for the trainer to set on every environment."""
+        extra = getattr(self, "_bound_extra", None)
+        if extra is not None and not getattr(self, "_bound_synced", True):
+            saved = extra.get(self.extra_key)
+            if saved:
+                self.load_state(dict(saved))
+            self._bound_synced = True
+        for episode in getattr(stats, "episodes", ()) or ():
+            self.update(episode)
+        if extra is not None:
+            extra[self.extra_key] = dict(self.state())
+        return self.env_attrs()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, ClassVar, Optional, Sequence
 
 from toolkit.interfaces.plugin import Plugin
 
@@ -104,16 +104,40 @@ class Searcher(Plugin, abc.ABC):
     search by constructing the searcher anew and replaying the recorded history through
     ``ask``/``tell`` (the recorded evaluations stand in for re-running them).
 
+    Required: ``ask``, ``tell``, ``finished`` and a ``Config`` with ``name`` and ``budget`` (the
+    most evaluations the runner makes). Optional, with defaults: ``batch_size`` (from the Config's
+    ``batch`` when it has one, else 1), ``nested`` (True), ``summary()`` (empty).
+
+    Attributes:
+        nested: True (default): each evaluation is a nested MLflow run under the outer run;
+            False: the one evaluation is logged on the outer run itself (``search=single``).
+
     Args:
         problem: what to search.
         cfg: the ``search`` config group, validated against ``Config``.
         seed: the run's seed.
     """
 
+    nested: ClassVar[bool] = True
+
     def __init__(self, problem: SearchProblem, cfg: Any, seed: int) -> None:
         self.problem = problem
         self.cfg = cfg
         self.seed = seed
+
+    @property
+    def batch_size(self) -> int:
+        """Points the runner asks for at once (and evaluates in parallel): the config's ``batch``
+        when the ``Config`` has one, else 1 -- a searcher that says nothing about batches is asked
+        one point at a time. Override it for another rule."""
+        cfg = self.cfg
+        if cfg is None:
+            return 1
+        if isinstance(cfg, dict) or hasattr(cfg, "keys"):  # a dict or a config node
+            value = cfg["batch"] if "batch" in cfg else None
+        else:  # a typed Config instance
+            value = getattr(cfg, "batch", None)
+        return 1 if value is None else int(value)
 
     @abc.abstractmethod
     def ask(self, n: int) -> "np.ndarray":

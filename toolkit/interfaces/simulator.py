@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
-from typing import TYPE_CHECKING, Any, ClassVar, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, ClassVar, Optional, Sequence
 
 from toolkit.interfaces.plugin import Plugin
 
@@ -85,6 +85,15 @@ class Simulator(Plugin, abc.ABC):
         n_links: the character's links besides the base.
         masses: link masses ``(n_links + 1,)``, base first (kg).
         model: the character's ``toolkit.dynamics.Model`` (``n_q``, ``n_v``, ``depth`` ...).
+        steps_itself: True when the configured SPD backend acts inside the engine's own step
+            (``SPDBackend.steps_itself``): the step records carry no torques (``tau`` is NaN) and
+            tasks that time or read the torques skip that. False by default.
+        planar_world: optional classmethod ``planar_world(urdf_path, sim_hz, friction, ...)``
+            opening a planar (2-D) world for ``task=standing_jump``; None (default): this
+            simulator has none, and that task says so.
+
+    Required: ``reset``, ``step``, ``state`` and the queries and scene methods below that a task
+    uses (the defaults raise ``NotImplementedError``); ``close`` releases the engine.
 
     Args:
         cfg: the whole run config (``cfg.sim``, ``cfg.character``, ``cfg.spd``).
@@ -94,6 +103,8 @@ class Simulator(Plugin, abc.ABC):
     time: float = 0.0
     ground: int = -1
     n_links: int = 0
+    steps_itself: bool = False
+    planar_world: ClassVar[Optional[Callable[..., Any]]] = None
     group_schemas: ClassVar[dict[str, type]] = {}
 
     def __init__(self, cfg: Any) -> None:

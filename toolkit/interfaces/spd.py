@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import abc
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from toolkit.interfaces.plugin import Plugin
 
@@ -23,9 +23,22 @@ class SPDBackend(Plugin, abc.ABC):
     child link's frame). Generalised forces use the ``qd`` layout (root: world force at the base
     frame origin, then world torque).
 
+    Required: ``bind`` and ``torques``. Optional, with defaults: ``steps_itself`` (False),
+    ``solve`` (= ``torques``), ``control`` (read, ``torques``, clip, apply), and ``apply`` (only a
+    backend with ``steps_itself`` has one).
+
+    Attributes:
+        steps_itself: False (default): ``torques`` returns the SPD torques, which the caller clips
+            and applies before stepping the engine. True: the backend acts inside the engine's own
+            step (PyBullet's STABLE_PD: ``spd=bullet``): it is bound to the engine's body (a
+            ``toolkit.dynamics.bullet_io.BulletBody``) instead of a ``Model``, the simulator calls
+            ``apply`` before every substep, and ``torques`` may raise ``NotImplementedError``.
+
     Args:
         cfg: the ``spd`` config group, validated against ``Config``.
     """
+
+    steps_itself: ClassVar[bool] = False
 
     def __init__(self, cfg: Any = None) -> None:
         self.cfg = cfg
@@ -59,3 +72,28 @@ class SPDBackend(Plugin, abc.ABC):
             tau_ext: other known generalised forces ``(n_dof,)`` acting this step (e.g. gravity
                 is already part of the bias term; this is for extra forces), zero if ``None``.
         """
+
+    def solve(self, q: "np.ndarray", qd: "np.ndarray", q_target: "np.ndarray", kp: "np.ndarray",
+              kd: "np.ndarray", dt: float, qd_target: "np.ndarray | None" = None) -> "np.ndarray":
+        """The simulator's per-substep path: ``torques`` for contiguous float64 arrays; a backend
+        may override it with a leaner one (no conversions). The default calls ``torques``."""
+        return self.torques(q, qd, q_target, kp, kd, dt, qd_target)
+
+    def control(self, io: Any, q_target: "np.ndarray", kp: "np.ndarray", kd: "np.ndarray", dt: float,
+                torque_limit: "np.ndarray", qd_target: "np.ndarray | None" = None) -> Any:
+        """One substep's control of a PyBullet body ``io`` (a ``toolkit.dynamics.bullet_io.BulletBody``):
+        read the state, compute the torques, clip them to ``±torque_limit`` and write them; the
+        caller then steps the engine. Returns the applied torques ``(n_dof,)``."""
+        import numpy as np
+
+        q, qd = io.read()
+        tau = np.clip(self.torques(q, qd, q_target, kp, kd, dt, qd_target), -torque_limit, torque_limit)
+        io.write_torques(tau)
+        return tau
+
+    def apply(self, q_target: "np.ndarray", kp: "np.ndarray", kd: "np.ndarray",
+              torque_limit: "np.ndarray", qd_target: "np.ndarray | None" = None) -> None:
+        """Arm the engine's own controller for the next step (backends with ``steps_itself``
+        only; the default says the backend has none)."""
+        raise NotImplementedError(f"{type(self).__name__} computes torques (steps_itself is False): "
+                                  "call torques(...) and apply them")
