@@ -24,14 +24,14 @@ from toolkit.config import group_of, plain
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import Hooks, PolicyTask
+from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
 HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate")  #: per-iteration episode means
 
 
 @dataclasses.dataclass
-class GetupConfig:
+class GetupConfig(PolicyConfig):
     """The ``task`` group of ``task=getup`` (``jt run task=getup --cfg`` prints every value)."""
 
     name: str = "getup"
@@ -97,12 +97,6 @@ class GetupConfig:
     """Deterministic evaluation get-ups (the rollout, then the other curves' clip starts and rag-doll states in turn) giving success_rate (ours)."""
     time_scale: float = 1.0
     """Default of the searched point: every curve's T times this (003 §4.3)."""
-    filmstrip_frames: int = 8
-    """Frames of the final get-up's filmstrip."""
-    filmstrip_width: int = 160
-    """Px per frame."""
-    filmstrip_height: int = 120
-    """Px."""
 
     def check(self) -> None:
         """One-line ``JtError`` for each mistake (unknown curve or style, control-point count ...)."""

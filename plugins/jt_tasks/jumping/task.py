@@ -24,13 +24,13 @@ from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask
 
 FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
 
 
 @dataclasses.dataclass
-class JumpConfig:
+class JumpConfig(PolicyConfig):
     """Parameters shared by the jumping tasks (the ``task`` group); the high jump's defaults.
 
     The task's other choices are Hydra defaults of ``conf/task/<task>.yaml``: P-VAE actions
@@ -83,12 +83,6 @@ class JumpConfig:
     """Substeps between contact checks (ours: every 600 Hz substep)."""
     distinct_threshold: float = 0.5
     """rad: Stage-1 features closer than this count as one strategy (ours)."""
-    filmstrip_frames: int = 8
-    """Frames of the final jump's filmstrip."""
-    filmstrip_width: int = 160
-    """px per filmstrip frame."""
-    filmstrip_height: int = 120
-    """px."""
 
     def check(self) -> None:
         """Range checks (one ``JtError`` line each)."""

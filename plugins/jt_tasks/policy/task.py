@@ -32,6 +32,20 @@ from jt_tasks.policy import train as tr
 
 
 @dataclasses.dataclass
+class PolicyConfig:
+    """What every policy task's ``task`` group has: the final rollout's pictures. A task's
+    ``Config`` derives from it (its own fields follow)."""
+
+    filmstrip_frames: int = 8
+    """Frames of the final deterministic rollout's filmstrip (0: no pictures); the GIF has every
+    control step's frame."""
+    filmstrip_width: int = 160
+    """px per frame."""
+    filmstrip_height: int = 120
+    """px."""
+
+
+@dataclasses.dataclass
 class Hooks:
     """PPO hooks a task gives its training (``toolkit.rl.ppo.train``)."""
 

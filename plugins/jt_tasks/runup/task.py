@@ -24,7 +24,7 @@ from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask
 
 
 def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
@@ -38,7 +38,7 @@ def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, 
 
 
 @dataclasses.dataclass
-class RunupConfig:
+class RunupConfig(PolicyConfig):
     """The ``task`` group of ``task=runup`` (conf/task/runup.yaml has each value's source)."""
 
     name: str = "runup"
@@ -74,12 +74,6 @@ class RunupConfig:
     """R_G is paid once, at take-off, times this; null: the episode's control steps (ours)."""
     eval_lead: Optional[float] = None
     """S before the take-off foot's mid-support that the final rollout starts; null: n_strides whole cycles (ours)."""
-    filmstrip_frames: int = 8
-    """Frames of the final run-up."""
-    filmstrip_width: int = 160
-    """Px per frame."""
-    filmstrip_height: int = 120
-    """Px."""
 
 
 class RunupTask(PolicyTask):

@@ -20,7 +20,7 @@ import numpy as np
 
 from toolkit.interfaces.task import Evaluation
 
-from jt_tasks.policy.task import PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask
 
 #: the clips whose heading is taken from the root's z axis (authors' code; research notes)
 Z_HEADING = ("backflip", "roll", "crawl")
@@ -55,7 +55,7 @@ def allowed_links(skeleton: Any, clip: str, names: Optional[list] = None) -> tup
 
 
 @dataclasses.dataclass
-class SpacetimeConfig:
+class SpacetimeConfig(PolicyConfig):
     """The ``task`` group of ``task=spacetime`` (every default with its source)."""
 
     name: str = "spacetime"
@@ -93,11 +93,7 @@ class SpacetimeConfig:
     allowed_contacts: Optional[list] = None
     """Link names allowed on the ground in the evaluation and the contact arm (["all"]: any); null: per clip (authors' code: walk feet, cartwheel feet and hands, crawl all but root/chest/neck, roll all)."""
     filmstrip_frames: int = 4
-    """Frames of the evaluation's filmstrip (ours)."""
-    filmstrip_width: int = 160
-    """Px per frame (ours)."""
-    filmstrip_height: int = 120
-    """Px (ours)."""
+    """Frames of the final rollout's filmstrip (ours)."""
 
     def check(self) -> None:
         """One-line ``JtError`` for a bad clip, width, channel, heading axis or range."""

@@ -3,7 +3,7 @@
 import dataclasses
 import numpy as np
 from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.task import PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask
 from toolkit.interfaces import ContactRule, Watch
 
 @dataclasses.dataclass
@@ -33,17 +33,11 @@ class StandEnv(CharacterEnv):
         return (0.0 if fell else 1.0), fell, rec["outcome"] == "truncate", {"reason": rec["reason"]}
 
 @dataclasses.dataclass
-class StandConfig:
+class StandConfig(PolicyConfig):     # filmstrip_frames, _width, _height come from PolicyConfig
     name: str = "stand"
     """Registry name."""
     time_limit: float = 5.0
     """s of standing asked for (ours)."""
-    filmstrip_frames: int = 4
-    """Frames of the final rollout's filmstrip."""
-    filmstrip_width: int = 160
-    """px."""
-    filmstrip_height: int = 120
-    """px."""
 
 class StandTask(PolicyTask):
     """Stay up: a minimal policy task."""
