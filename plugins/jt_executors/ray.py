@@ -40,6 +40,10 @@ class _RayActors(ActorGroup):
         from ray.util.scheduling_strategies import PlacementGroupSchedulingStrategy
 
         self._ray = ray
+        have = float(ray.cluster_resources().get("CPU", 0))
+        if cpus * len(args) > have:  # the group could never start: say so instead of waiting forever
+            raise JtError(f"{len(args)} actors of {cpus:g} CPUs (agent.n_workers, executor.cpus_per_task) "
+                          f"do not fit the Ray cluster's {have:g} CPUs")
         self._pg = placement_group([{"CPU": cpus}] * len(args), strategy="PACK") if args else None
 
         @ray.remote(num_cpus=cpus, max_restarts=0)

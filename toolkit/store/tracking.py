@@ -4,6 +4,10 @@ Everything goes through ``MlflowClient`` with explicit run ids (never MLflow's g
 run"), so a driver can keep an outer run and many nested evaluation runs open at once, and two jt
 processes can share a store. Creating a fresh store is serialised with a lock file, because two
 processes running MLflow's schema migrations on the same new database at once would collide.
+
+A store may also be an MLflow tracking server, ``store=http://host:port``: ``Store(uri)`` then
+returns a ``toolkit.store.server.ServerStore``, which logs and reads artifacts through the server
+and keeps working folders in a local cache.
 """
 
 from __future__ import annotations
@@ -22,9 +26,24 @@ MAX_PARAMS_PER_BATCH = 100
 MAX_METRICS_PER_BATCH = 1000
 
 
-def store_root(path: Optional[str] = None) -> Path:
-    """Absolute store root: ``path``, else ``$JT_STORE``, else ``./artifacts``."""
-    return Path(path or os.environ.get("JT_STORE") or "artifacts").expanduser().resolve()
+def is_server_uri(ref: Any) -> bool:
+    """Whether ``ref`` names an MLflow tracking server (``http://`` or ``https://``)."""
+    return isinstance(ref, str) and ref.lower().startswith(("http://", "https://"))
+
+
+def store_root(path: Optional[str | os.PathLike] = None) -> Path | str:
+    """The store ``path``, else ``$JT_STORE``, else ``./artifacts``: an absolute folder, or a
+    server URI as it is (without a trailing ``/``)."""
+    ref = path or os.environ.get("JT_STORE") or "artifacts"
+    if is_server_uri(str(ref)):
+        return str(ref).rstrip("/")
+    return Path(ref).expanduser().resolve()
+
+
+def quiet_mlflow_logs() -> None:
+    """MLflow's and its database's INFO lines off (call after importing mlflow: it sets its own)."""
+    for name in ("alembic", "mlflow", "sqlalchemy"):
+        logging.getLogger(name).setLevel(logging.WARNING)
 
 
 @contextmanager
@@ -43,16 +62,26 @@ class Store:
     for artifacts, ``<root>/work/<run>/`` for evaluation working folders (checkpoints).
 
     Args:
-        root: store directory (created if missing).
+        root: store directory (created if missing), or an MLflow server URI (``http://host:port``),
+            for which a ``toolkit.store.server.ServerStore`` is returned.
     """
+
+    is_server = False
+    """Whether the store is an MLflow tracking server (``toolkit.store.server.ServerStore``)."""
+
+    def __new__(cls, root: str | os.PathLike, *args: Any, **kwargs: Any) -> "Store":
+        if cls is Store and is_server_uri(str(root)):
+            from toolkit.store.server import ServerStore
+
+            return super().__new__(ServerStore)
+        return super().__new__(cls)
 
     def __init__(self, root: str | os.PathLike) -> None:
         self.root = Path(root).resolve()
         self.uri = f"sqlite:///{self.root / 'mlflow.db'}"
         from mlflow.tracking import MlflowClient
 
-        for name in ("alembic", "mlflow", "sqlalchemy"):  # after import: mlflow sets its own levels
-            logging.getLogger(name).setLevel(logging.WARNING)
+        quiet_mlflow_logs()
 
         with _locked(self.root):
             self.client = MlflowClient(tracking_uri=self.uri)

@@ -19,6 +19,10 @@ from pathlib import Path
 from typing import Optional
 
 RAY = str(Path(sys.executable).with_name("ray"))
+DRIVER_ENV = {"RAY_USAGE_STATS_ENABLED": "0", "RAY_AUTH_MODE": "disabled"}
+"""Environment of the nodes and of a driver connecting to them. Token authentication is off
+explicitly: Ray >= 2.5x turns it on by itself once ``~/.ray/auth_token`` exists (a local
+``ray.init()`` writes one), and then a node or driver without the token cannot join."""
 
 
 def free_port() -> int:
@@ -47,6 +51,25 @@ def cmdline(pid: int) -> str:
         return ""
 
 
+def session_pids(sessions: list[int]) -> list[int]:
+    """Every live process in one of ``sessions``."""
+    return [int(n) for n in os.listdir("/proc") if n.isdigit() and session_of(int(n)) in sessions]
+
+
+def end_sessions(sessions: list[int], term_s: float = 3.0) -> None:
+    """SIGTERM every process of ``sessions`` (processes this test started, each in its own
+    session), wait up to ``term_s``, then SIGKILL what is left."""
+    for sig, wait in ((signal.SIGTERM, term_s), (signal.SIGKILL, 2.0)):
+        for p in session_pids(sessions):
+            try:
+                os.kill(p, sig)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + wait
+        while session_pids(sessions) and time.monotonic() < deadline:
+            time.sleep(0.2)
+
+
 def node_of(seconds: float) -> str:
     """The id of the Ray node running this after ``seconds`` (a task for ``executor.map``)."""
     import ray
@@ -66,7 +89,7 @@ class LocalRayCluster:
 
     def __init__(self, nodes: int = 2, cpus: int = 1, env: Optional[dict] = None) -> None:
         self.nodes, self.cpus = nodes, cpus
-        self.env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", **(env or {})}
+        self.env = {**os.environ, **DRIVER_ENV, **(env or {})}
         # a short private folder: Ray's socket paths must stay under the 107-byte limit
         self.temp = Path(tempfile.mkdtemp(prefix="jtray-"))
         self.port = free_port()
@@ -86,7 +109,7 @@ class LocalRayCluster:
             self.sessions.append(proc.pid)  # its session id: the daemons it leaves keep it
             rc = proc.wait(timeout=120)
         if rc != 0:
-            raise RuntimeError(f"ray start failed ({rc}):\n{self.log.read_text()[-3000:]}")
+            raise RuntimeError(f"ray start failed ({rc}):\n{self.log.read_text()[-6000:]}")
 
     def start(self) -> "LocalRayCluster":
         """Start the head, then the other nodes; returns self once every node has joined."""
@@ -102,11 +125,7 @@ class LocalRayCluster:
 
     def pids(self) -> list[int]:
         """Every live process of this cluster."""
-        out = []
-        for name in os.listdir("/proc"):
-            if name.isdigit() and session_of(int(name)) in self.sessions:
-                out.append(int(name))
-        return out
+        return session_pids(self.sessions)
 
     def workers(self, title: str) -> list[int]:
         """Worker processes whose title starts with ``title`` (e.g. ``ray::jt_evaluate``)."""
@@ -114,16 +133,7 @@ class LocalRayCluster:
 
     def stop(self) -> None:
         """End every process of this cluster (TERM, then KILL) and remove its folder."""
-        for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 2.0)):
-            pids = self.pids()
-            for p in pids:
-                try:
-                    os.kill(p, sig)
-                except ProcessLookupError:
-                    pass
-            deadline = time.monotonic() + wait
-            while self.pids() and time.monotonic() < deadline:
-                time.sleep(0.2)
+        end_sessions(self.sessions)
         shutil.rmtree(self.temp, ignore_errors=True)
 
     def __enter__(self) -> "LocalRayCluster":

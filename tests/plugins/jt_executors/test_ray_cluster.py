@@ -17,9 +17,10 @@ import time
 
 import pytest
 
-from tests.plugins.jt_executors.executor_contract import ExecutorContract
-from tests.plugins.jt_executors.ray_cluster import LocalRayCluster, node_of
+from tests.plugins.jt_executors.executor_contract import Counter, ExecutorContract
+from tests.plugins.jt_executors.ray_cluster import DRIVER_ENV, LocalRayCluster, node_of
 from toolkit.config import compose
+from toolkit.errors import JtError
 from toolkit.execution.runner import run
 
 ray = pytest.importorskip("ray")
@@ -29,7 +30,9 @@ ray = pytest.importorskip("ray")
 def cluster(example_plugin_dir):
     """Two nodes; their workers import the example plugin (``task=quadratic``)."""
     path = os.pathsep.join(p for p in (str(example_plugin_dir), os.environ.get("PYTHONPATH", "")) if p)
-    with LocalRayCluster(nodes=2, cpus=1, env={"PYTHONPATH": path}) as c:
+    with pytest.MonkeyPatch.context() as mp, LocalRayCluster(nodes=2, cpus=1, env={"PYTHONPATH": path}) as c:
+        for k, v in DRIVER_ENV.items():
+            mp.setenv(k, v)
         yield c
 
 
@@ -49,6 +52,10 @@ class TestContractOnCluster(ExecutorContract):
         ex = RayExecutor(RayExecutor.Config(address=cluster.address, workers=2))
         yield ex
         ex.close()
+
+    def test_actors_that_cannot_fit_are_refused(self, executor):
+        with pytest.raises(JtError, match="3 actors of 1 CPUs .* do not fit the Ray cluster's 2 CPUs"):
+            executor.actors(Counter, [(0,), (1,), (2,)])
 
     def test_work_spreads_over_both_nodes(self, executor):
         assert executor.n_workers == 2
