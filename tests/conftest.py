@@ -1,4 +1,7 @@
-"""Shared fixtures: a temp store, and the third-party example plugin installed into a temp dir."""
+"""Shared fixtures: a temp store, and the third-party example plugin installed into a temp dir.
+
+No test module goes directly in tests/plugins/ (tests/toolkit/testing/test_test_layout.py says why).
+"""
 
 from __future__ import annotations
 
