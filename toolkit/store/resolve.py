@@ -74,11 +74,13 @@ def open_store(store: Any) -> Any:
 
     Unlike ``Store(...)`` this never creates a store; an open ``Store`` is returned as it is.
     """
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import Store, is_server_uri, store_root
 
     if isinstance(store, Store):
         return store
     root = store_root(store)
+    if is_server_uri(root):  # a tracking server: it exists or Store says so in one line
+        return Store(root)
     return Store(root) if (root / "mlflow.db").is_file() else None
 
 
