@@ -98,7 +98,11 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
         try:
             for i, res in executor.imap(_cell, [(ov, parallel) for _, ov, _ in cells]):
                 results[i] = res
-                store.set_tags(res[0], {"mlflow.parentRunId": run_id, "jt.compare_id": run_id})
+                values, _, cell_cfg = cells[i]
+                variant = "·".join(f"{k}={v}" for k, v in zip(keys, values) if k != "seed")
+                name = store.unique_run_name(experiment, f"{variant + '·' if variant else ''}seed={cell_cfg.seed}")
+                store.set_tags(res[0], {"mlflow.parentRunId": run_id, "jt.compare_id": run_id,
+                                        "mlflow.runName": name})
         finally:
             executor.close()
         per_cell = [(", ".join(f"{k}={v}" for k, v in zip(keys, values)), rid, m)

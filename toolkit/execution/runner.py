@@ -100,7 +100,9 @@ def _open_run(store: Store, cfg: Any, experiment: str) -> tuple[str, bool]:
         "jt.search": str(cfg.search.name),
         "mlflow.source.name": "jt",
     }
-    run_id = store.start_run(experiment, run_name=cfg.get("run_name"), tags=tags)
+    name = cfg.get("run_name") or store.unique_run_name(
+        experiment, f"{cfg.task.name}·{cfg.search.name}·seed{cfg.seed}")  # what it is, never a collision
+    run_id = store.start_run(experiment, run_name=name, tags=tags)
     store.log_params(run_id, flatten(cfg))
     cfg_path = store.workdir(run_id) / "config.yaml"
     cfg_path.write_text(to_yaml(cfg))

@@ -116,6 +116,23 @@ class Store:
         run = self.client.create_run(self.experiment_id(experiment), run_name=run_name, tags=tags)
         return run.info.run_id
 
+    def unique_run_name(self, experiment: str, base: str) -> str:
+        """``base``, or ``base·2``, ``base·3`` ... : the first name no run of ``experiment`` has
+        (MLflow's own names come from Python's global ``random``, which jt seeds: they collide)."""
+        if "'" in base or "\\" in base:
+            return base
+        exp = self.client.get_experiment_by_name(experiment)
+        if exp is None:
+            return base
+        taken = {r.info.run_name for r in self.client.search_runs(
+            [exp.experiment_id], filter_string=f"attributes.run_name LIKE '{base}%'", max_results=50000)}
+        if base not in taken:
+            return base
+        k = 2
+        while f"{base}·{k}" in taken:
+            k += 1
+        return f"{base}·{k}"
+
     def end_run(self, run_id: str, status: str = "FINISHED", reason: Optional[str] = None) -> None:
         """Close a run with ``FINISHED``, ``FAILED`` or ``KILLED`` (and the reason as a tag)."""
         if reason:

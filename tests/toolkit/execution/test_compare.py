@@ -59,3 +59,21 @@ def test_vary_with_no_or_repeated_values_is_one_line():
     for bad in (["seed=,"], ["spd=df,df"]):
         with pytest.raises(JtError, match="bad --vary"):
             parse_vary(bad)
+
+
+def test_runs_are_named_for_what_they_are_and_never_collide(example_plugin, store_dir):
+    """Outer runs ``<task>·<search>·seed<N>`` (a second one ``...·2``); compare children
+    ``<variant>·seed=<N>``: MLflow's own names come from the global random that jt seeds."""
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+    from toolkit.store.tracking import Store
+
+    a = run(compose(["task=quadratic", "executor.workers=1", f"store={store_dir}"]))
+    b = run(compose(["task=quadratic", "executor.workers=1", f"store={store_dir}"]))
+    store = Store(store_dir)
+    assert store.get_run(a.run_id).info.run_name == "quadratic·single·seed0"
+    assert store.get_run(b.run_id).info.run_name == "quadratic·single·seed0·2"
+    res = compare(["task=quadratic", "executor.workers=1", f"store={store_dir}"], ["task.centre=0.0,0.5"], seeds=1)
+    kids = store.get_run(res.run_id).data.tags["jt.compare.runs"].split(",")
+    names = [store.get_run(k).data.tags["mlflow.runName"] for k in kids]
+    assert names == ["task.centre=0.0·seed=0", "task.centre=0.5·seed=0"]
