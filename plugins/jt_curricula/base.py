@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import abc
 import math
-from typing import Any, Optional
+from typing import Any
 
 from toolkit.interfaces.curriculum import Curriculum
 from toolkit.config import config_of
@@ -44,8 +44,6 @@ class IterationCurriculum(Curriculum):
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         self.params = config_of(type(self).Config, cfg, f"curriculum={type(self).name or type(self).__name__}")
-        self._extra: Optional[dict[str, Any]] = None
-        self._synced = False
 
     @abc.abstractmethod
     def end_iteration(self, iteration: int, samples: int, stats: Any) -> None:
@@ -65,27 +63,3 @@ class IterationCurriculum(Curriculum):
         """True once training may stop (e.g. ``z_freeze`` reached); never for a plain curriculum."""
         return False
 
-    def bind(self, extra: dict[str, Any]) -> dict[str, Any]:
-        """Keep this curriculum's state in ``extra[extra_key]`` (the trainer's checkpointed dict).
-
-        Returns:
-            ``extra`` itself, holding the current ``state()`` unless it already holds a saved one.
-        """
-        self._extra = extra
-        self._synced = False
-        extra.setdefault(self.extra_key, dict(self.state()))
-        return extra
-
-    def on_iteration(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
-        """The PPO trainer's hook: update from ``stats`` and return the environments' attributes."""
-        if self._extra is not None and not self._synced:
-            saved = self._extra.get(self.extra_key)
-            if saved:
-                self.load_state(dict(saved))
-            self._synced = True
-        for episode in getattr(stats, "episodes", ()) or ():
-            self.update(episode)
-        self.end_iteration(iteration, samples, stats)
-        if self._extra is not None:
-            self._extra[self.extra_key] = dict(self.state())
-        return self.env_attrs()

@@ -45,6 +45,10 @@ class Curriculum(Plugin, abc.ABC):
         """Attributes to set on every environment for the current difficulty (none by default)."""
         return {}
 
+    def end_iteration(self, iteration: int, samples: int, stats: Any) -> None:
+        """Account for one finished training iteration, after its episodes went to ``update``
+        (nothing by default)."""
+
     def bind(self, extra: dict[str, Any]) -> dict[str, Any]:
         """Keep this curriculum's state in ``extra[extra_key]`` (the trainer's checkpointed dict);
         on resume the trainer refills ``extra`` in place and the next ``on_iteration`` loads it.
@@ -59,7 +63,8 @@ class Curriculum(Plugin, abc.ABC):
 
     def on_iteration(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
         """The PPO trainer's hook after each iteration: every finished episode of ``stats.episodes``
-        goes to ``update``; returns ``env_attrs()`` for the trainer to set on every environment."""
+        goes to ``update``, then ``end_iteration``; returns ``env_attrs()`` for the trainer to set on
+        every environment."""
         extra = getattr(self, "_bound_extra", None)
         if extra is not None and not getattr(self, "_bound_synced", True):
             saved = extra.get(self.extra_key)
@@ -68,6 +73,7 @@ class Curriculum(Plugin, abc.ABC):
             self._bound_synced = True
         for episode in getattr(stats, "episodes", ()) or ():
             self.update(episode)
+        self.end_iteration(iteration, samples, stats)
         if extra is not None:
             extra[self.extra_key] = dict(self.state())
         return self.env_attrs()

@@ -24,7 +24,7 @@ from toolkit.config import group_of, plain
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask
+from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask, require_humanoid_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
 HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate")  #: per-iteration episode means
@@ -154,17 +154,8 @@ class GetupTask(PolicyTask):
     @classmethod
     def check_run(cls, cfg: Any) -> None:
         """The humanoid (the curves and start poses come from its clips) and a prior for action=cvae/pvae."""
-        from toolkit.errors import JtError
-
-        character = str(group_of(group_of(cfg, "character") or {}, "name") or "humanoid")
-        if character != "humanoid":
-            raise JtError(f"task=getup needs character=humanoid (its curves and start poses come from the "
-                          f"DeepMimic humanoid's get-up clips), got character={character}")
-        action = group_of(cfg, "action")
-        name = str(group_of(action, "name") or "") if action is not None else ""
-        if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
-            raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
-                          f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
+        require_humanoid_and_prior(cfg, "getup", "its curves and start poses come from the DeepMimic "
+                                               "humanoid's get-up clips")
 
     def problem(self) -> SearchProblem:
         return SearchProblem(space=Space((Param("time_scale", 0.5, 2.0, float(self.params.time_scale)),)))

@@ -24,7 +24,7 @@ from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import PolicyConfig, PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask, require_humanoid_and_prior
 
 FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
 
@@ -106,22 +106,6 @@ class JumpConfig(PolicyConfig):
                                                        self.filmstrip_height), "frames >= 0, sizes > 0")
 
 
-def check_character_and_prior(cfg: Any, task: str) -> None:
-    """``character=humanoid`` (a jump or run-up starts from the DeepMimic humanoid's clips) and a
-    prior for ``action=pvae|cvae``: one ``JtError`` line each."""
-    from toolkit.errors import JtError
-
-    character = str(group_of(group_of(cfg, "character") or {}, "name") or "humanoid")
-    if character != "humanoid":
-        raise JtError(f"task={task} needs character=humanoid (its take-off states come from the DeepMimic "
-                      f"humanoid's clips), got character={character}")
-    action = group_of(cfg, "action")
-    name = str(group_of(action, "name") or "") if action is not None else ""
-    if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
-        raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
-                      f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
-
-
 class JumpTask(PolicyTask):
     """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
 
@@ -135,7 +119,7 @@ class JumpTask(PolicyTask):
     def check_run(cls, cfg: Any) -> None:
         """The jumps need the humanoid (their take-off states come from its clips) and, for the
         P-VAE / C-VAE action spaces, a trained prior."""
-        check_character_and_prior(cfg, cls.Config().name)
+        require_humanoid_and_prior(cfg, cls.Config().name, "its take-off states come from the DeepMimic humanoid's clips")
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

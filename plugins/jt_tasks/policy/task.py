@@ -31,6 +31,21 @@ from toolkit.interfaces.task import EvalContext, Evaluation, Task
 from jt_tasks.policy import train as tr
 
 
+def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
+    """For ``Task.check_run``: ``character=humanoid`` (``why`` says what the task takes from its
+    clips) and, for ``action=pvae|cvae``, a trained prior; one ``JtError`` line each."""
+    from toolkit.errors import JtError
+
+    character = str(group_of(group_of(cfg, "character") or {}, "name") or "humanoid")
+    if character != "humanoid":
+        raise JtError(f"task={task} needs character=humanoid ({why}), got character={character}")
+    action = group_of(cfg, "action")
+    name = str(group_of(action, "name") or "") if action is not None else ""
+    if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
+        raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
+                      f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
+
+
 @dataclasses.dataclass
 class PolicyConfig:
     """What every policy task's ``task`` group has: the final rollout's pictures. A task's

@@ -24,7 +24,7 @@ from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import PolicyConfig, PolicyTask
+from jt_tasks.policy.task import PolicyConfig, PolicyTask, require_humanoid_and_prior
 
 
 def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
@@ -87,9 +87,7 @@ class RunupTask(PolicyTask):
     def check_run(cls, cfg: Any) -> None:
         """The run-up imitates the DeepMimic humanoid's run: character=humanoid (and a prior for
         the VAE action spaces)."""
-        from jt_tasks.jumping.task import check_character_and_prior
-
-        check_character_and_prior(cfg, "runup")
+        require_humanoid_and_prior(cfg, "runup", "it imitates the DeepMimic humanoid's run")
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
