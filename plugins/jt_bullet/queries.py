@@ -132,34 +132,51 @@ class SceneQueries:
 
     def ray(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
         """Hit points ``(n, 3)`` of rays ``starts -> ends`` ``(n, 3)`` against the scene, the
-        character excluded; NaN rows where a ray hits nothing."""
+        character's own bodies ignored; NaN rows where a ray hits nothing else.
+
+        A ray whose first hit is the character is cast again reporting every hit along it
+        (PyBullet's ``reportHitNumber``: Bullet's all-hits callback, in no particular order) and
+        takes the nearest hit on anything else: a ray through a character lying on the ground
+        reaches the ground under it (re-casting from just past the first hit starts inside the
+        body, which Bullet's ray test then misses on convex shapes).
+        """
         import pybullet as pb
 
         starts, ends = np.asarray(starts, float).reshape(-1, 3), np.asarray(ends, float).reshape(-1, 3)
         out = np.full(starts.shape, np.nan)
-        me = self.character.body_id
-        for i0 in range(0, len(starts), pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1):
-            chunk = slice(i0, i0 + pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1)
-            hits = pb.rayTestBatch(starts[chunk].tolist(), ends[chunk].tolist(), physicsClientId=self.client)
+        me, blocked = self.character.body_id, []
+        batch = pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1
+        for i0 in range(0, len(starts), batch):
+            hits = pb.rayTestBatch(starts[i0:i0 + batch].tolist(), ends[i0:i0 + batch].tolist(),
+                                   physicsClientId=self.client)
             for j, h in enumerate(hits):
                 if h[0] >= 0 and h[0] != me:
                     out[i0 + j] = h[3]
-                elif h[0] == me:  # the character is in the way: cast again from just past it
-                    out[i0 + j] = self._ray_past_character(starts[i0 + j], ends[i0 + j])
+                elif h[0] == me:
+                    blocked.append(i0 + j)
+        if blocked:
+            out[blocked] = self._rays_past_character(starts[blocked], ends[blocked])
         return out
 
-    def _ray_past_character(self, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+    def _rays_past_character(self, starts: np.ndarray, ends: np.ndarray, max_hits: int = 64) -> np.ndarray:
+        """Nearest hit ``(n, 3)`` on a body other than the character along each ray (NaN: none), from
+        the k-th hits of every ray, k = 0, 1, ... until no ray has a k-th hit."""
         import pybullet as pb
 
-        me, s = self.character.body_id, np.array(start, float)
-        for _ in range(16):
-            h = pb.rayTest(s.tolist(), list(map(float, end)), physicsClientId=self.client)[0]
-            if h[0] < 0:
-                return np.full(3, np.nan)
-            if h[0] != me:
-                return np.array(h[3])
-            s = np.array(h[3]) + 1e-4 * (np.asarray(end) - s) / max(np.linalg.norm(np.asarray(end) - s), 1e-12)
-        return np.full(3, np.nan)
+        me = self.character.body_id
+        out = np.full(starts.shape, np.nan)
+        best = np.full(len(starts), np.inf)
+        batch = pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1
+        for i0 in range(0, len(starts), batch):
+            s, e = starts[i0:i0 + batch].tolist(), ends[i0:i0 + batch].tolist()
+            for k in range(max_hits):
+                hits = pb.rayTestBatch(s, e, reportHitNumber=k, physicsClientId=self.client)
+                if all(h[0] < 0 for h in hits):
+                    break
+                for j, h in enumerate(hits):
+                    if h[0] >= 0 and h[0] != me and h[2] < best[i0 + j]:
+                        best[i0 + j], out[i0 + j] = h[2], h[3]
+        return out
 
     # ------------------------------------------------------------------ scene
     def add_box(self, half_extents: Sequence[float], position: Sequence[float],
@@ -193,7 +210,8 @@ class SceneQueries:
         # centred on the mid-height; turned by Z_TO_Y its local (x, y, z) become world (x, -z, y).
         data = h[:, ::-1].T.reshape(-1)  # local y = -world z
         col = pb.createCollisionShape(pb.GEOM_HEIGHTFIELD, meshScale=[cell, cell, 1.0], heightfieldData=data.tolist(),
-                                      numHeightfieldRows=n_x, numHeightfieldColumns=n_z, **kw)
+                                      numHeightfieldRows=n_x, numHeightfieldColumns=n_z,
+                                      flags=pb.GEOM_CONCAVE_INTERNAL_EDGE, **kw)  # no snags on edges
         mid = 0.5 * (float(h.max()) + float(h.min()))
         pos = [float(origin[0]), float(origin[1]) + mid, float(origin[2])]
         body = pb.createMultiBody(0.0, col, -1, pos, list(Z_TO_Y), **kw)
