@@ -49,13 +49,17 @@ class IterationStats(dict):
             in learning units, i.e. with ``reward_scale``). These four win over equally named
             ``info`` keys. What importance sampling of start states needs (spacetime bounds eqs
             11-12): a task can weight its start phases by ``target`` or ``target - value``.
+        visits: one dict per batch row whose env reported its state (an env method
+            ``visit_state()`` returning an array; none by default): ``state``, ``env``, ``step``,
+            ``value`` and ``target`` as in ``starts`` (spacetime bounds eq 12's candidates).
     """
 
     def __init__(self, scalars: dict[str, float], episodes: list[dict[str, float]],
-                 starts: Optional[list[dict[str, float]]] = None) -> None:
+                 starts: Optional[list[dict[str, float]]] = None, visits: Optional[list[dict[str, Any]]] = None) -> None:
         super().__init__(scalars)
         self.episodes = episodes
         self.starts = [] if starts is None else starts
+        self.visits = [] if visits is None else visits
 
 
 @dataclasses.dataclass
@@ -384,7 +388,9 @@ def train(
             for k, v in stats.items():
                 history.setdefault(k, []).append(float(v))
             if on_iteration is not None:
-                attrs = on_iteration(iteration, samples, IterationStats(stats, eps, starts))
+                visits = [{**v, "value": float(batch["values"][v["step"], v["env"]]),
+                           "target": float(targets[v["step"], v["env"]])} for v in batch.get("visits", [])]
+                attrs = on_iteration(iteration, samples, IterationStats(stats, eps, starts, visits))
                 if attrs:
                     env_attrs.update(attrs)
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)

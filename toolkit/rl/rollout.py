@@ -102,6 +102,8 @@ class RolloutWorker:
         self._ep_len = np.zeros(len(self.envs), dtype=np.int64)
         # reset-info scalars of each env's current episode until its first observation is batched
         self._pending_start: list[Optional[dict[str, float]]] = [None] * len(self.envs)
+        # optional env.visit_state() -> array | None: the state of each batch row, for the learner
+        self._visit = [getattr(getattr(env, "unwrapped", env), "visit_state", None) for env in self.envs]
 
     def set_weights(self, state: dict[str, np.ndarray]) -> None:
         """Load the learner's ``ActorCritic.numpy_state()``."""
@@ -141,7 +143,9 @@ class RolloutWorker:
             per episode finished in this call (``return``, ``length``, ``terminated`` and the
             numeric scalars of the last step's ``info``), and ``starts``: one dict per episode whose
             first observation is in this batch (the numeric scalars of the ``info`` its
-            ``env.reset`` returned, then ``env``: global env index, ``step``: its row ``t``).
+            ``env.reset`` returned, then ``env``: global env index, ``step``: its row ``t``), and
+            ``visits``: for envs with a ``visit_state()`` method, one dict per row whose call
+            returned an array (``state``, ``env``, ``step``), the state before that row's step.
             ``next_values[t]`` is the value of the
             state reached by step ``t``: for a time-limit truncation the value of the final
             observation (bootstrapping), for the last step of the call the value of the state the
@@ -165,6 +169,7 @@ class RolloutWorker:
         final_obs: list[tuple[int, int, np.ndarray]] = []  # (t, env, obs) at truncations
         episodes: list[dict[str, float]] = []
         starts: list[dict[str, float]] = []
+        visits: list[dict[str, Any]] = []
         with single_thread(), torch.no_grad():
             for t in range(n_steps):
                 obs_t = torch.from_numpy(self._obs)
@@ -182,6 +187,9 @@ class RolloutWorker:
                 env_act = self.model.to_env(out_act[t])
                 next_obs = np.empty_like(self._obs)
                 for j, env in enumerate(self.envs):
+                    state = self._visit[j]() if self._visit[j] is not None else None
+                    if state is not None:
+                        visits.append({"state": state, "env": self.env_ids[j], "step": t})
                     o, r, te, tr, info = env.step(env_act[j].astype(env.action_space.dtype))
                     o = np.asarray(o, dtype=np.float32).reshape(-1)
                     rewards[t, j], term[t, j], trunc[t, j] = float(r), bool(te), bool(tr and not te)
@@ -209,7 +217,7 @@ class RolloutWorker:
         return {
             "obs": out_obs, "actions": out_act, "logp": out_logp, "values": out_val[:-1].copy(),
             "next_values": out_next, "rewards": rewards, "terminated": term, "truncated": trunc,
-            "episodes": episodes, "starts": starts,
+            "episodes": episodes, "starts": starts, "visits": visits,
         }
 
     def peak_rss_mb(self) -> float:

@@ -2,7 +2,13 @@
 
 * Reference state initialisation: an episode starts in the reference state at a phase drawn
   uniformly from ``[0, 1)`` with the env's ``np_random`` (``reset(options={"phase": φ})`` or the
-  spec's ``init_phase`` fixes it), clip time ``t0 = φ T``.
+  spec's ``init_phase`` fixes it), clip time ``t0 = φ T``. Once the learner has set the attribute
+  ``start_sampling`` (``jt_tasks.spacetime.sampling``), the start segment is drawn with its eq 11
+  probabilities ``probs`` (002 §4.3.1) and the phase uniformly inside it; with the evolution's
+  buffers (002 §4.3.2 eq 12) present, a share ``share`` of starts is a buffer state of that
+  segment instead (uniform over its ``count`` states; root x, z placed at the reference's).
+  ``visit_state()`` reports each state (``[phase, q with root x, z = 0, qd]``) to PPO when the
+  spec's ``sampling["evolution"]`` is on.
 * Action (``action=ffc_fbc``, 002 §4.2): the PD target is the reference pose at the control
   step's phase (the action space's feed-forward controller, fed the phase here) plus the policy's
   correction; held over the control step's substeps (600 Hz / 30 Hz).
@@ -13,6 +19,8 @@
 * ``termination: contact`` (the DeepMimic baseline of 002 Table 1): a ground contact of a link not
   allowed for the clip ends the episode with reward 0; otherwise DeepMimic's imitation reward
   (``jt_tasks.runup.reward.imitation_terms``).
+* ``mix = w_s`` (either arm): the reward is eq 13's ``(1 − w_s) r_imitation + w_s r_style``
+  (002 §5.3.1, Table 2) instead of the style product / the imitation reward.
 * An episode is truncated (bootstrapped) at ``time_limit`` (20 s, 002 §5.1), or, for a
   non-looping clip, ``hold_s`` after the clip's end (the clip holds its last frame).
 * Evaluation (``reset(options={"evaluate": True})``, 002 Table 1): bounds off, only a forbidden
@@ -57,12 +65,17 @@ class SpacetimeSpec:
     eval_allowed: tuple = (5, 11)  # links allowed on the ground in the evaluation
     eval_time_limit: float = 20.0
     style: list = dataclasses.field(default_factory=list)  # [{"name": term, ...params}] (jt.rewards)
+    mix: Optional[float] = None  # eq 13 weight w_s of the style terms in the contact arm (None: product)
+    sampling: dict = dataclasses.field(default_factory=dict)  # {"evolution": bool} (sampling.SamplingParams)
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "ffc_fbc"})
 
 
 class SpacetimeEnv(CharacterEnv):
     """Track a reference clip inside its spacetime bounds (002 §3.2), or the DeepMimic baseline."""
+
+    start_sampling: Optional[dict] = None
+    """Eq 11 / eq 12 start distribution set by the learner (``StartSampler.payload``); None: uniform."""
 
     def setup(self) -> None:
         from toolkit import plugins
@@ -86,13 +99,19 @@ class SpacetimeEnv(CharacterEnv):
             return ()
         return (ContactRule(self.sim.ground, "fail", "forbidden ground contact", links=tuple(forbidden)),)
 
-    def _start(self, phase: float, evaluate: bool = False) -> None:
+    def _start(self, phase: float, evaluate: bool = False, state: Optional[np.ndarray] = None) -> None:
         spec = self.spec_
         self.evaluating = bool(evaluate)
-        self.phase0 = float(phase)
+        self.phase0 = float(phase if state is None else min(max(float(state[0]), 0.0), 1.0))
         self.t0 = self.phase0 * self.ref.period
         ref = self.ref.sample(self.t0)
-        self.sim.reset(ref.q, ref.qd)
+        if state is None:
+            self.sim.reset(ref.q, ref.qd)
+        else:  # an evolved state (002 §4.3.2), root x, z at the reference's (authors' code)
+            n_q = len(ref.q)
+            q, qd = np.array(state[1:1 + n_q], dtype=float), np.array(state[1 + n_q:], dtype=float)
+            q[0], q[2] = ref.q[0], ref.q[2]
+            self.sim.reset(q, qd)
         if hasattr(self.action_space_, "reset"):
             self.action_space_.reset(ref.phase)
         if evaluate:
@@ -108,6 +127,7 @@ class SpacetimeEnv(CharacterEnv):
         self.reward_sum = 0.0
         self.last_d = np.zeros(len(self.names))
         self._links_now = self._links_prev = self.sim.link_states()[0] if self.style_terms else None
+        self._vel_prev = self._qd_prev = None
 
     @property
     def t(self) -> float:
@@ -133,14 +153,34 @@ class SpacetimeEnv(CharacterEnv):
     # ------------------------------------------------------------------ gymnasium hooks
     def start(self, options: Optional[dict]) -> dict:
         options = options or {}
+        evaluate, state, segment = bool(options.get("evaluate", False)), None, -1
+        pay = self.start_sampling
         if options.get("phase") is not None:
             phase = float(options["phase"])
         elif self.spec_.init_phase is not None:
             phase = float(self.spec_.init_phase)
-        else:
+        elif pay is None or evaluate:
             phase = float(self.np_random.uniform(0.0, 1.0))
-        self._start(phase, bool(options.get("evaluate", False)))
-        return {"start_phase": self.phase0}
+        else:  # 002 §4.3: eq 11 segment, then a reference phase in it or an eq 12 buffer state
+            probs = np.asarray(pay["probs"], dtype=float)
+            segment = int(self.np_random.choice(len(probs), p=probs / probs.sum()))
+            phase = (segment + float(self.np_random.uniform(0.0, 1.0))) / len(probs)
+            count = int(np.asarray(pay["count"])[segment]) if pay.get("count") is not None else 0
+            if count > 0 and float(self.np_random.uniform(0.0, 1.0)) < float(pay.get("share", 1.0)):
+                state = np.asarray(pay["states"])[segment, int(self.np_random.integers(count))]
+        self._start(phase, evaluate, state)
+        return {"start_phase": self.phase0, "start_segment": float(segment), "from_buffer": float(state is not None)}
+
+    def visit_state(self) -> Optional[np.ndarray]:
+        """``[phase, q (root x, z = 0), qd]`` ``(1 + n_q + n_qd,)`` of the state now, for the
+        evolution's buffers (002 §4.3.2); None when the spec's evolution is off or evaluating."""
+        if not self.spec_.sampling.get("evolution") or self.evaluating:
+            return None
+        q, qd = self.sim.state()
+        q = np.array(q, dtype=float)
+        q[0] = q[2] = 0.0
+        phase = self.ref.phase(self.clip_time)
+        return np.concatenate([[phase], q, np.asarray(qd, dtype=float)])
 
     def pd_targets(self, action: np.ndarray) -> np.ndarray:
         if hasattr(self.action_space_, "set_phase"):  # the FFC's phase: this control step's
@@ -160,15 +200,22 @@ class SpacetimeEnv(CharacterEnv):
         return np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
 
     def style_reward(self, q: np.ndarray, qd: np.ndarray) -> float:
-        """Product of the style terms (1 without any). Their record: ``link_pos`` / ``link_vel``
-        ``(n_links + 1, 3)`` (centres of mass; velocities by differences over the control step),
-        ``masses``, ``joint_pos`` ``(n_links, 3)`` (joint origins), ``q``, ``qd``."""
+        """Product of the style terms (1 without any). Their record: ``link_pos`` / ``link_vel`` /
+        ``link_acc`` ``(n_links + 1, 3)`` (centres of mass; velocities and accelerations by
+        differences over the control step, accelerations 0 at an episode's first step), ``masses``,
+        ``joint_pos`` ``(n_links, 3)`` (joint origins), ``q``, ``qd``, ``joint_acc`` ``(n_dof,)``
+        (internal dofs, by differences of ``qd``), ``clip`` (the reference clip's name or path)."""
         if not self.style_terms:
             return 1.0
         pos = self._links_now
+        vel = (pos - self._links_prev) * self.control_hz
+        qd = np.asarray(qd, dtype=float)
+        acc = np.zeros_like(vel) if self._vel_prev is None else (vel - self._vel_prev) * self.control_hz
+        jacc = np.zeros(len(qd) - 6) if self._qd_prev is None else (qd[6:] - self._qd_prev[6:]) * self.control_hz
+        self._vel_prev, self._qd_prev = vel, qd.copy()
         joints = np.array([self.sim.link_pose(i)[0] for i in range(self.n_links)])
-        record = {"q": q, "qd": qd, "link_pos": pos, "link_vel": (pos - self._links_prev) * self.control_hz,
-                  "joint_pos": joints, "masses": self.masses}
+        record = {"q": q, "qd": qd, "link_pos": pos, "link_vel": vel, "link_acc": acc, "joint_acc": jacc,
+                  "joint_pos": joints, "masses": self.masses, "clip": self.spec_.clip}
         out = 1.0
         for _, term in self.style_terms:
             out *= float(term(record))
@@ -192,15 +239,14 @@ class SpacetimeEnv(CharacterEnv):
             if out:
                 terminated, reason = True, "out of bounds: " + ",".join(out)
             else:
-                q, qd = self.sim.state()
-                reward = self.style_reward(q, qd)
+                reward = self.task_reward()
                 truncated = outcome == "truncate"
                 reason = rec["reason"] if truncated else ""
         else:
             if outcome == "fail":
                 terminated, reason = True, rec["reason"]
             else:
-                reward = self.imitation()
+                reward = self.imitation() if self.spec_.mix is None else self.task_reward()
                 truncated = outcome == "truncate"
                 reason = rec["reason"] if truncated else ""
         self.reward_sum += reward
@@ -212,6 +258,17 @@ class SpacetimeEnv(CharacterEnv):
             for name in reason[len("out of bounds: "):].split(","):
                 info[f"out_{name}"] = 1.0
         return float(reward), terminated, truncated, info
+
+    def task_reward(self) -> float:
+        """The reward of a control step inside the bounds (or, in the contact arm, without a
+        forbidden contact): the style product (002 §5: survival 1 × style), or with ``mix = w_s``
+        the eq 13 blend ``(1 − w_s) r_imitation + w_s r_style`` (002 §5.3.1, Table 2)."""
+        q, qd = self.sim.state()
+        style = self.style_reward(q, qd)
+        if self.spec_.mix is None:
+            return style
+        w = float(self.spec_.mix)
+        return (1.0 - w) * self.imitation() + w * style
 
     def imitation(self) -> float:
         """DeepMimic's imitation reward (Peng et al. 2018 §6) of the current state vs the reference."""

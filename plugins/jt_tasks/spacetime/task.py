@@ -20,7 +20,7 @@ import numpy as np
 
 from toolkit.interfaces.task import Evaluation
 
-from jt_tasks.policy.task import PolicyConfig, PolicyTask
+from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask
 
 #: the clips whose heading is taken from the root's z axis (authors' code; research notes)
 Z_HEADING = ("backflip", "roll", "crawl")
@@ -94,6 +94,42 @@ class SpacetimeConfig(PolicyConfig):
     """Link names allowed on the ground in the evaluation and the contact arm (["all"]: any); null: per clip (authors' code: walk feet, cartwheel feet and hands, crawl all but root/chest/neck, roll all)."""
     filmstrip_frames: int = 4
     """Frames of the final rollout's filmstrip (ours)."""
+    mix: Optional[float] = None
+    """Eq 13 weight w_s: reward (1 - w_s) imitation + w_s style in either arm (002 §5.3.1 Table 2: 0.5-0.8); null: survival x style / imitation."""
+    importance_sampling: Optional[bool] = None
+    """Start segments by eq 11 (002 §4.3.1); null: on with termination=bounds, off (uniform RSI, DeepMimic) with contact."""
+    n_segments: int = 10
+    """Segments of the clip for eq 11 and eq 12 (002 §4.3.1; authors' code: 10 for the Table 1 motions)."""
+    is_uniform: float = 0.2
+    """U of eq 11, the share of uniformly drawn segments (002 §4.3.1)."""
+    is_average: float = 0.99
+    """Running-average factor of each segment's start targets w_k (authors' code; 002 §4.3.1: "average")."""
+    is_reading: str = "paper"
+    """Eq 11 temperature: paper v = (max - min) / 3 (002 §4.3.1); code v = (max - min) + 0.01 (authors' code)."""
+    evolution: bool = False
+    """Initial-state evolution, eq 12 (002 §4.3.2, for low-quality references; authors' code: off for every Table 1 motion)."""
+    evolution_size: int = 200
+    """M, states per segment buffer (002 §4.3.2 leaves m open; authors' code: 200, 100 Atlas, 20 long dances)."""
+    evolution_reading: str = "paper"
+    """Eq 12: paper exp(-w/v), v = max - min, favours low returns (002 §4.3.2); code exp(3 (w - max) / (gap + 0.01)), favours high, old values x 0.95 (authors' code)."""
+    evolution_share: Optional[float] = None
+    """Share of starts from a buffer state; null: 1 with the paper reading (002 §4.3.2: starts are drawn from the buffers), 0.8 with the code's (authors' code)."""
+    evolution_warmup: Optional[int] = None
+    """Iterations before buffer starts begin; null: 0 with the paper reading (002 §4.3.2), 400 with the code's (authors' code)."""
+
+    def sampling_params(self, termination: Optional[str] = None):
+        """The ``SamplingParams`` these fields give (readings' defaults filled in)."""
+        from jt_tasks.spacetime.sampling import SamplingParams
+
+        code = self.evolution_reading == "code"
+        term = self.termination if termination is None else termination
+        return SamplingParams(
+            importance=(term == "bounds") if self.importance_sampling is None else bool(self.importance_sampling),
+            n_segments=int(self.n_segments), uniform=float(self.is_uniform), average=float(self.is_average),
+            is_reading=str(self.is_reading), evolution=bool(self.evolution), buffer_size=int(self.evolution_size),
+            share=(0.8 if code else 1.0) if self.evolution_share is None else float(self.evolution_share),
+            warmup=(400 if code else 0) if self.evolution_warmup is None else int(self.evolution_warmup),
+            evolution_reading=str(self.evolution_reading), decay=0.95 if code else 1.0)
 
     def check(self) -> None:
         """One-line ``JtError`` for a bad clip, width, channel, heading axis or range."""
@@ -122,6 +158,17 @@ class SpacetimeConfig(PolicyConfig):
             require(not bad, "task.allowed_contacts", bad, f"unknown link(s); links: {', '.join(sorted(known))}")
         for t in self.style:
             require(isinstance(t, dict) and "name" in t, "task.style", t, "a list of {name: <jt.rewards term>, ...}")
+        require(self.mix is None or (finite(self.mix) and 0.0 <= self.mix <= 1.0), "task.mix", self.mix,
+                "null or a weight w_s in [0, 1] (002 eq 13)")
+        for key in ("is_reading", "evolution_reading"):
+            require(getattr(self, key) in ("paper", "code"), f"task.{key}", getattr(self, key), "paper or code")
+        require(int(self.n_segments) >= 1 and int(self.evolution_size) >= 1, "task.n_segments/evolution_size",
+                (self.n_segments, self.evolution_size), "integers >= 1")
+        for key in ("is_uniform", "is_average", "evolution_share"):
+            v = getattr(self, key)
+            require(v is None or (finite(v) and 0.0 <= v <= 1.0), f"task.{key}", v, "a number in [0, 1]")
+        require(self.evolution_warmup is None or int(self.evolution_warmup) >= 0, "task.evolution_warmup",
+                self.evolution_warmup, "null or an iteration count >= 0")
         require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
                 "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,
                                                        self.filmstrip_height), "frames >= 0, sizes > 0")
@@ -168,7 +215,20 @@ class SpacetimeTask(PolicyTask):
                              widths=[float(x) for x in w], time_limit=float(p.time_limit), hold_s=float(p.hold_s),
                              init_phase=p.init_phase, train_allowed=allowed, eval_allowed=allowed,
                              eval_time_limit=float(p.eval_time_limit), style=[dict(t) for t in p.style],
-                             sim=sim, action=action)
+                             mix=None if p.mix is None else float(p.mix),
+                             sampling={"evolution": bool(p.evolution)}, sim=sim, action=action)
+
+    def training(self, spec: Any, ctx: Any) -> Hooks:
+        """PPO's ``on_iteration``: eq 11 start weights and eq 12 buffers (``StartSampler``), every
+        iteration, sent to the envs as ``start_sampling``; the sampler's state rides in ``extra``."""
+        from jt_tasks.spacetime.sampling import StartSampler
+
+        params = self.params.sampling_params()
+        extra: dict[str, Any] = {}
+        if not (params.importance or params.evolution):
+            return Hooks(extra=extra, state={"sampler": None})
+        sampler = StartSampler(params, extra, ctx.seed)
+        return Hooks(on_iteration=sampler.update, extra=extra, state={"sampler": sampler})
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def final_options(self, env: Any) -> Optional[dict]:
@@ -201,4 +261,16 @@ class SpacetimeTask(PolicyTask):
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         history = {"mean_return": return_curve(trained),
                    "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
+        sampler = hooks.state.get("sampler")
+        h = sampler.history() if sampler is not None else None
+        if h is not None:
+            from jt_tasks.spacetime.artifacts import write_start_sampling
+
+            write_start_sampling(workdir, h)
+            history["is_max_prob"] = [(int(x), float(p.max())) for x, p in zip(h["samples"], h["probs"])]
+            metrics["is_max_prob"] = float(h["probs"][-1].max())
+            metrics["is_entropy"] = float(-(h["probs"][-1] * np.log(h["probs"][-1])).sum())
         return Evaluation(metrics=metrics, history=history)
+
+    def extra_artifacts(self, workdir: Path) -> list[str]:
+        return [n for n in ("start_sampling.h5", "start_sampling.png") if (Path(workdir) / n).exists()]

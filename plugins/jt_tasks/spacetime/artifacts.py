@@ -1,0 +1,56 @@
+"""Artifacts of ``task=spacetime`` besides the policy layer's: the start distribution per iteration.
+
+``write_start_sampling`` writes ``start_sampling.h5`` (``samples`` ``(n_it,)``, ``probs``, ``w``,
+``count`` ``(n_it, n_segments)``: eq 11's start-segment probabilities, the segments' running
+averages of the start targets, and eq 12's buffer sizes after each iteration, 002 §4.3) and
+``start_sampling.png`` (the probabilities as an image: iteration down, segment across, and the
+last iteration's as bars).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def write_start_sampling(workdir: Path, h: dict[str, np.ndarray]) -> list[str]:
+    """``start_sampling.h5`` and ``start_sampling.png`` in ``workdir`` from ``StartSampler.history()``."""
+    from toolkit.store import h5
+
+    workdir = Path(workdir)
+    h5.write(workdir / "start_sampling.h5", {k: np.asarray(v, dtype=float) for k, v in h.items()},
+             {"what": "002 eq 11 start-segment probabilities per PPO iteration", "n_segments": int(h["probs"].shape[1])})
+    plot_start_sampling(h, workdir / "start_sampling.png")
+    return ["start_sampling.h5", "start_sampling.png"]
+
+
+def plot_start_sampling(h: dict[str, np.ndarray], out: Path) -> Path:
+    """Two panels: p(k) per iteration (image) and the last iteration's p(k) with w_k (bars)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    probs, w = np.asarray(h["probs"]), np.asarray(h["w"])
+    n = probs.shape[1]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3))
+    im = a.imshow(probs, aspect="auto", origin="lower", cmap="viridis", interpolation="nearest",
+                  extent=(0, 1, 0.5, probs.shape[0] + 0.5))
+    a.set_xlabel("start phase (segment)")
+    a.set_ylabel("PPO iteration")
+    a.set_title("eq 11: p(segment)")
+    fig.colorbar(im, ax=a)
+    x = (np.arange(n) + 0.5) / n
+    b.bar(x, probs[-1], width=0.9 / n, label="p(k), last iteration")
+    b.axhline(1.0 / n, color="gray", lw=0.8, ls="--", label="uniform")
+    b.set_xlabel("start phase")
+    b.set_ylabel("p(k)")
+    b2 = b.twinx()
+    b2.plot(x, w[-1], "o-", color="C3", ms=3, label="w_k")
+    b2.set_ylabel("w_k (start target)")
+    b.legend(loc="upper left", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return Path(out)
