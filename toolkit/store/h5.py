@@ -88,3 +88,59 @@ def read_attrs(path: str | os.PathLike) -> dict[str, Any]:
     """Root attributes of an HDF5 file."""
     with h5py.File(path, "r") as f:
         return {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+
+
+def _fmt_value(v: Any, limit: int = 80) -> str:
+    if isinstance(v, bytes):
+        v = v.decode(errors="replace")
+    if isinstance(v, np.ndarray) and v.dtype.kind == "S":
+        v = v.astype(str)
+    if isinstance(v, np.ndarray):
+        text = np.array2string(v, threshold=8, edgeitems=3, max_line_width=10_000)
+    else:
+        text = str(v)
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def preview(path: str | os.PathLike, max_lines: int = 400) -> str:
+    """A short text view of an HDF5 file: every group and dataset (shape, dtype, and the values
+    of small ones: at most 8 elements) and every attribute, indented by depth.
+
+    Args:
+        path: the ``.h5`` file.
+        max_lines: cut the listing after this many lines (says how many more there are).
+
+    Returns:
+        The text, ending with a newline (what ``<name>.h5.txt`` beside an artifact holds).
+    """
+    path = Path(path)
+    lines = [f"{path.name}: HDF5, {path.stat().st_size} bytes (name  shape dtype  [= values]; @attribute = value)"]
+
+    def attrs(obj: Any, pad: str) -> None:
+        for k, v in obj.attrs.items():
+            lines.append(f"{pad}@{k} = {_fmt_value(v)}")
+
+    def walk(g: "h5py.Group", pad: str) -> None:
+        attrs(g, pad)
+        for key, item in g.items():
+            if isinstance(item, h5py.Group):
+                lines.append(f"{pad}{key}/")
+                walk(item, pad + "  ")
+            else:
+                if item.shape is None:  # an empty (null dataspace) dataset
+                    lines.append(f"{pad}{key}  empty {item.dtype}")
+                    attrs(item, pad + "  ")
+                    continue
+                shape = "scalar" if item.shape == () else "×".join(map(str, item.shape))
+                text = f"{pad}{key}  {shape} {item.dtype}"
+                if item.size <= 8:
+                    text += f"  = {_fmt_value(item[()])}"
+                lines.append(text)
+                attrs(item, pad + "  ")
+
+    with h5py.File(path, "r") as f:
+        walk(f, "")
+    if len(lines) > max_lines:
+        lines = [*lines[:max_lines], f"… {len(lines) - max_lines} more lines"]
+    return "\n".join(lines) + "\n"

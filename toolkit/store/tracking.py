@@ -86,6 +86,21 @@ class Store:
         with _locked(self.root):
             self.client = MlflowClient(tracking_uri=self.uri)
             self.client.search_experiments(max_results=1)  # creates/migrates the schema under the lock
+            self._default_inside()
+
+    def _default_inside(self) -> None:
+        """Point MLflow's "Default" experiment (id 0) into the store: MLflow creates it with the
+        artifact location ``<cwd>/mlruns/0``, outside the store (and MLflow has no call to move it)."""
+        import sqlite3
+
+        inside = str(self.root / "runs" / "Default")
+        con = sqlite3.connect(self.root / "mlflow.db", timeout=30)
+        try:
+            with con:
+                con.execute("UPDATE experiments SET artifact_location = ? WHERE experiment_id = 0 "
+                            "AND artifact_location != ?", (inside, inside))
+        finally:
+            con.close()
 
     # ---- experiments and runs ------------------------------------------------------------
     def experiment_id(self, name: str) -> str:
@@ -101,6 +116,16 @@ class Store:
             if exp is None:
                 raise
             return exp.experiment_id
+
+    def describe_experiment(self, name: str, description: str, tags: Optional[Mapping[str, str]] = None) -> str:
+        """Give experiment ``name`` (created if missing) a markdown description (MLflow's
+        ``mlflow.note.content``, shown on its page) and tags, unless it has them; returns its id."""
+        eid = self.experiment_id(name)
+        have = self.client.get_experiment(eid).tags
+        for key, value in {"mlflow.note.content": description, **(tags or {})}.items():
+            if key not in have:
+                self.client.set_experiment_tag(eid, key, str(value))
+        return eid
 
     def start_run(
         self,
@@ -176,25 +201,54 @@ class Store:
             self.client.log_batch(run_id, tags=[RunTag(str(k), str(v)) for k, v in tags.items()])
 
     def log_artifacts(self, run_id: str, folder: str | os.PathLike, artifact_path: Optional[str] = None) -> None:
-        """Copy every file under ``folder`` into the run's artifacts (skipping temp files)."""
+        """Copy every file under ``folder`` into the run's artifacts (skipping temp files; an
+        ``.h5`` gets its ``.h5.txt`` preview beside it)."""
         folder = Path(folder)
         for p in sorted(folder.rglob("*")):
-            if p.is_file() and ".tmp-" not in p.name and p.suffix != ".lock":
+            if p.is_file() and ".tmp-" not in p.name and p.suffix != ".lock" and not _is_preview(p):
                 rel = p.parent.relative_to(folder)
                 sub = str(Path(artifact_path) / rel) if artifact_path else (str(rel) if str(rel) != "." else None)
-                self.client.log_artifact(run_id, str(p), artifact_path=sub)
+                self.log_artifact(run_id, p, artifact_path=sub)
 
     def log_artifact(self, run_id: str, path: str | os.PathLike, artifact_path: Optional[str] = None) -> None:
-        """Copy one file into the run's artifacts."""
+        """Copy one file into the run's artifacts; an HDF5 file (``.h5``) also gets a text preview
+        ``<name>.h5.txt`` beside it (groups, datasets, shapes, attributes), which the UI shows."""
         self.client.log_artifact(run_id, str(path), artifact_path=artifact_path)
+        if Path(path).suffix == ".h5":
+            import tempfile
+
+            from toolkit.store import h5
+
+            with tempfile.TemporaryDirectory(prefix="jt-preview-") as tmp:
+                preview = Path(tmp) / f"{Path(path).name}.txt"
+                preview.write_text(h5.preview(path))
+                self.client.log_artifact(run_id, str(preview), artifact_path=artifact_path)
 
     def metrics(self, run_id: str) -> "MetricBuffer":
         """A metric buffer for ``run_id`` (flush it, or use it as a context manager)."""
         return MetricBuffer(self, run_id)
 
 
+def _is_preview(path: Path) -> bool:
+    """Whether ``path`` is an HDF5 preview jt writes itself (``x.h5.txt`` beside ``x.h5``)."""
+    return path.name.endswith(".h5.txt") and path.with_name(path.name[:-4]).is_file()
+
+
+def user() -> str:
+    """Who runs jt (MLflow's ``mlflow.user``; the UI's "Created by")."""
+    import getpass
+
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):
+        return os.environ.get("USER", "unknown")
+
+
 class MetricBuffer:
     """Collects metrics and writes them with ``log_batch`` (one ``log_metric`` costs ~8 ms).
+
+    A metric is logged at most once per step: a second value for the same ``(key, step)`` in one
+    buffer is dropped (a chart that runs 0.83 → 0.07 at one step helps nobody).
 
     Args:
         store: the store.
@@ -205,15 +259,30 @@ class MetricBuffer:
     def __init__(self, store: Store, run_id: str, flush_every: int = MAX_METRICS_PER_BATCH) -> None:
         self.store, self.run_id, self.flush_every = store, run_id, flush_every
         self._items: list[Any] = []
+        self._seen: set[tuple[str, int]] = set()
 
-    def add(self, key: str, value: float, step: int = 0, timestamp: Optional[int] = None) -> None:
-        """Queue one metric value (NaN/inf are logged as they are; MLflow accepts them)."""
+    def add(self, key: str, value: float, step: int = 0, timestamp: Optional[float] = None) -> bool:
+        """Queue one metric value (NaN/inf are logged as they are; MLflow accepts them).
+
+        Args:
+            key: metric name.
+            value: its value.
+            step: the x of a curve (samples, iterations); 0 for a final value.
+            timestamp: when it was measured, Unix seconds (default: now).
+
+        Returns:
+            False when ``(key, step)`` was already queued in this buffer (the value is dropped).
+        """
         from mlflow.entities import Metric
 
-        ts = timestamp if timestamp is not None else int(time.time() * 1000)
+        if (str(key), int(step)) in self._seen:
+            return False
+        self._seen.add((str(key), int(step)))
+        ts = int(round((timestamp if timestamp is not None else time.time()) * 1000))
         self._items.append(Metric(str(key), float(value), ts, int(step)))
         if len(self._items) >= self.flush_every:
             self.flush()
+        return True
 
     def add_many(self, values: Mapping[str, float], step: int = 0) -> None:
         """Queue several metrics at one step."""

@@ -40,3 +40,20 @@ def test_no_file_until_complete(tmp_path):
     with pytest.raises(RuntimeError):
         h5.write(tmp_path / "new.h5", {"w": Boom()})
     assert not os.listdir(tmp_path)
+
+
+def test_preview_lists_groups_datasets_shapes_and_attributes(tmp_path):
+    path = h5.write(tmp_path / "f.h5", {"root": np.zeros((100, 7)), "g": {"names": np.array(["a", "bb"]), "k": 3}},
+                    attrs={"format": "jt.test/1"})
+    lines = h5.preview(path).splitlines()
+    assert lines[0].startswith("f.h5: HDF5, ")
+    assert "@format = jt.test/1" in lines
+    assert "root  100×7 float64" in lines  # a big dataset: shape and type, no values
+    assert "g/" in lines and "  names  2 |S2  = ['a' 'bb']" in lines and "  k  scalar int64  = 3" in lines
+    import h5py
+
+    with h5py.File(tmp_path / "e.h5", "w") as f:  # what h5py writes for an empty value
+        f.create_dataset("nothing", data=h5py.Empty("f8"))
+    assert "nothing  empty float64" in h5.preview(tmp_path / "e.h5")
+    many = h5.write(tmp_path / "m.h5", {f"d{i}": i for i in range(50)})
+    assert h5.preview(many, max_lines=10).splitlines()[-1] == "… 41 more lines"
