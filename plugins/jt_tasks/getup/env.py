@@ -33,6 +33,7 @@ import numpy as np
 from jt_tasks.getup import features as F
 from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.initial import clip_pose, pick_curve
+from jt_tasks.getup.terrain import TerrainSpec, add_terrain, place_on_ground, sample_locations
 from jt_tasks.policy.env import CharacterEnv
 from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
@@ -60,6 +61,7 @@ class GetupSpec:
     success_window: float = 1.0
     heightmap_n: int = 5
     heightmap_spacing: float = 0.25
+    terrain: dict = dataclasses.field(default_factory=dict)  # terrain.TerrainSpec.to_dict(); {}: flat only
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
 
@@ -99,7 +101,16 @@ class GetupEnv(CharacterEnv):
         self.stand_state = (q_stand, np.zeros_like(qd_stand))
         self.neutral = joint_rotations(q_stand)  # q̂ of eq 9: the clip's final standing pose (ours)
         self._clip_starts: dict[tuple, tuple] = {}
-        self.terrain_level = 0  # set by the terrain curriculum (flat only so far)
+        self.terrain_level = 0  # highest unlocked region, set by the terrain curriculum (003 §5.4)
+        self.region = 0  # the episode's region
+        self.tspec = TerrainSpec.from_dict(spec.terrain) if spec.terrain else None
+        self.ground_bodies = {int(self.sim.ground)}
+        if self.tspec is not None:
+            friction = float((spec.sim.get("sim") or {}).get("friction", 1.0))
+            self.ground_bodies.add(add_terrain(self.sim, self.tspec, friction))
+        self.fallen_by_region: dict[int, list[int]] = {}
+        for i, st in enumerate(spec.fallen):
+            self.fallen_by_region.setdefault(int(st.get("region", 0)), []).append(i)
         self._begin(0, "clip" if self.curves[0].clip else "standing", None)
 
     # ------------------------------------------------------------------ episodes
@@ -109,7 +120,7 @@ class GetupEnv(CharacterEnv):
             self._clip_starts[key] = clip_pose(c.clip, c.mirrored, frame=0)
         return self._clip_starts[key]
 
-    def _begin(self, curve: int, kind: str, fallen: Optional[int]) -> None:
+    def _begin(self, curve: int, kind: str, fallen: Optional[int], where: Optional[np.ndarray] = None) -> None:
         c = self.curves[curve]
         if kind == "clip":
             q, qd = self._clip_start(c)
@@ -118,7 +129,10 @@ class GetupEnv(CharacterEnv):
             q, qd = np.asarray(st["q"], float), np.asarray(st["qd"], float)
         else:
             q, qd = self.stand_state
-        self.sim.reset(np.array(q), np.array(qd))
+        if where is not None:  # a standing start on irregular terrain, feet not re-oriented (ours)
+            place_on_ground(self.sim, q, qd, where)
+        else:
+            self.sim.reset(np.array(q), np.array(qd))
         self.action_space_.reset(None)
         self.curve_index, self.curve, self.start_kind = curve, c, kind
         self.t_offset = c.duration if kind == "standing" else 0.0  # standing: s = 1 from the start
@@ -127,13 +141,17 @@ class GetupEnv(CharacterEnv):
                            time_limit_reason="time limit")
         self.low_t = self.head_t = self.stand_t = 0.0
         self.got_up = False
+        self.rise_t = math.nan  # s from the start until the neck first reaches the standing height
         self.log: list[dict[str, float]] = []
         self.last_action = np.zeros(self.action_space.shape, dtype=np.float64)
         self._prev_links = None
         self._m = None
         self.supine = bool(self.measure()["features"][2] < math.pi / 2)
-        self.head_down_at_start = F.HEAD_LINK in {link for _, link in self.sim.contacts(self.sim.ground)} \
-            or self._head_height() < 0.15
+        self.head_down_at_start = self._head_contact() or self._head_height() < 0.15
+
+    def _head_contact(self) -> bool:
+        """The head link touches the ground plane or the terrain."""
+        return any(link == F.HEAD_LINK and body in self.ground_bodies for body, link in self.sim.contacts())
 
     def _head_height(self) -> float:
         lo, _ = self.sim.aabb(F.HEAD_LINK)
@@ -145,25 +163,37 @@ class GetupEnv(CharacterEnv):
         return float(self.sim.time) + self.t_offset
 
     def start(self, options: Optional[dict]) -> dict:
+        """A new episode (003 §5.2, §5.4): a region among the unlocked ``0..terrain_level`` (all keep
+        being visited), then on flat ground a standing, rag-doll or clip start, on irregular ground a
+        standing start at a random location or a rag-doll state dropped there (clip poses are used on
+        flat terrain only, 003 §5.2). Options: ``kind``, ``curve`` (index or name), ``fallen`` (index
+        into the spec's states), ``region``."""
         spec, rng = self.spec_, self.np_random
         opts = dict(options or {})
-        kind, curve, fallen = opts.get("kind"), opts.get("curve"), opts.get("fallen")
+        kind, curve, fallen, region = opts.get("kind"), opts.get("curve"), opts.get("fallen"), opts.get("region")
         if isinstance(curve, str):
             names = [c.name for c in self.curves]
             curve = names.index(curve) if curve in names else None
-        with_clip = [i for i, c in enumerate(self.curves) if c.clip]
+        top = min(int(self.terrain_level), self.tspec.n_regions - 1) if self.tspec is not None else 0
+        if fallen is not None:
+            region = int(spec.fallen[int(fallen)].get("region", 0))
+        elif region is None:
+            region = int(rng.integers(top + 1))
+        region = int(region) if self.tspec is not None else 0
+        pool_fallen = self.fallen_by_region.get(region, [])
+        with_clip = [i for i, c in enumerate(self.curves) if c.clip] if region == 0 else []
         if kind is None:
             u = float(rng.random())
             if u < spec.p_standing:
                 kind = "standing"
-            elif u < spec.p_standing + spec.p_fallen and spec.fallen:
+            elif (u < spec.p_standing + spec.p_fallen or region > 0) and pool_fallen:
                 kind = "fallen"
             else:
-                kind = "clip" if with_clip else ("fallen" if spec.fallen else "standing")
-        if kind == "fallen" and not spec.fallen:
+                kind = "clip" if with_clip else ("fallen" if pool_fallen else "standing")
+        if kind == "fallen" and fallen is None and not pool_fallen:
             kind = "clip" if with_clip else "standing"
         if kind == "fallen":
-            fallen = int(rng.integers(len(spec.fallen))) if fallen is None else int(fallen)
+            fallen = int(pool_fallen[int(rng.integers(len(pool_fallen)))]) if fallen is None else int(fallen)
             if curve is None:
                 st = spec.fallen[fallen]
                 self.sim.reset(np.asarray(st["q"], float), np.asarray(st["qd"], float))
@@ -173,11 +203,15 @@ class GetupEnv(CharacterEnv):
         if curve is None:
             pool = with_clip if kind == "clip" else list(range(len(self.curves)))
             curve = int(pool[int(rng.integers(len(pool)))])
-        if kind == "clip" and not self.curves[int(curve)].clip:
+        if kind == "clip" and (not self.curves[int(curve)].clip or region > 0):
             kind = "standing"
-        self._begin(int(curve), kind, fallen)
+        where = None
+        if kind == "standing" and region > 0:
+            where = sample_locations(self.tspec, region, 1, rng)[0]
+        self.region = region
+        self._begin(int(curve), kind, fallen, where)
         return {"curve": float(self.curve_index), "start_kind": float(START_KINDS.index(kind)),
-                "terrain_level": float(self.terrain_level)}
+                "terrain_level": float(self.region), "unlocked_level": float(self.terrain_level)}
 
     # ------------------------------------------------------------------ measurements
     def _measure_now(self) -> dict[str, Any]:
@@ -248,10 +282,12 @@ class GetupEnv(CharacterEnv):
         r = r_task * math.prod(v for k, v in values.items() if k in self.natural)
         self.low_t = self.low_t + self.dt if r_task < spec.r_task_min else 0.0
         grace = spec.head_grace if self.head_down_at_start and self.start_kind != "standing" else 0.0
-        head = F.HEAD_LINK in {link for _, link in self.sim.contacts(self.sim.ground)}
+        head = self._head_contact()
         self.head_t = self.head_t + self.dt if head and self.sim.time > grace else 0.0
         standing = record["h"] >= spec.success_height * record["target_h_end"]
         self.stand_t = self.stand_t + self.dt if standing else 0.0
+        if standing and not self.got_up:
+            self.rise_t = float(self.sim.time)
         self.got_up = self.got_up or standing
         self.log.append({"r": r, "r_task": r_task, **{f"r_{k}": v for k, v in values.items()},
                          "h": record["h"], "theta_x": record["theta_x"], "theta_z": record["theta_z"],
@@ -276,8 +312,10 @@ class GetupEnv(CharacterEnv):
                                 "got_up": float(self.got_up and not standing),
                                 "standing_success": float(success and standing),
                                 "start_kind": float(START_KINDS.index(self.start_kind)),
-                                "curve": float(self.curve_index), "terrain_level": float(self.terrain_level),
-                                "episode_time": float(self.sim.time), "steps": float(len(self.log))}
+                                "curve": float(self.curve_index), "terrain_level": float(self.region),
+                                "unlocked_level": float(self.terrain_level),
+                                "episode_time": float(self.sim.time), "steps": float(len(self.log)),
+                                "time_to_rise": float(self.rise_t) if not standing else math.nan}
         if self.log:
             for k in self.log[0]:
                 if k.startswith("r"):

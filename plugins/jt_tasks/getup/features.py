@@ -109,19 +109,12 @@ def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0) 
 
 
 def ground_heights(sim: Any, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-    """Terrain heights ``(n,)`` under vertical rays ``starts -> ends`` (the character excluded).
-
-    Where a ray misses (``sim.ray`` gives up on rays through a character lying on the ground), it
-    is cast again from just above the heights the other rays found (from inside the body, which a
-    ray does not hit); a ray that still misses takes the mean of the others (ours).
+    """Terrain heights ``(n,)`` under vertical rays ``starts -> ends`` (``sim.ray`` ignores the
+    character, so rays through a lying body reach the ground under it); a ray that misses
+    everything (off the world's edge) takes the mean of the others, or the rays' lowest end (ours).
     """
-    hits = sim.ray(starts, ends)[:, 1]
+    hits = np.asarray(sim.ray(starts, ends), float)[:, 1]
     bad = ~np.isfinite(hits)
-    if bad.any() and (~bad).any():
-        again = starts[bad].copy()
-        again[:, 1] = float(np.max(hits[~bad])) + 0.02
-        hits[bad] = sim.ray(again, ends[bad])[:, 1]
-        bad = ~np.isfinite(hits)
     if bad.all():
         return np.full(len(hits), float(np.min(ends[:, 1])))
     hits[bad] = float(np.mean(hits[~bad]))

@@ -91,9 +91,12 @@ def perturb_joints(q: np.ndarray, rng: np.random.Generator, scale: float) -> np.
     return q
 
 
-def passive_groups(sim_groups: dict, kd: float) -> dict:
-    """The simulator groups with the PD servos off (kp = 0) and joint damping ``kd``: a rag-doll."""
+def passive_groups(sim_groups: dict, kd: float, sim_hz: Optional[float] = None) -> dict:
+    """The simulator groups with the PD servos off (kp = 0) and joint damping ``kd``: a rag-doll;
+    simulated at ``sim_hz`` when given."""
     out = {k: dict(v or {}) for k, v in sim_groups.items()}
+    if sim_hz:
+        out["sim"] = {**out.get("sim", {}), "sim_hz": float(sim_hz)}
     out["character"] = {**out.get("character", {}), "kp": 0.0, "kd": float(kd),
                         "joint_kp": {}, "joint_kd": {}}
     return out
@@ -101,8 +104,10 @@ def passive_groups(sim_groups: dict, kd: float) -> dict:
 
 def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = STYLES, drop_height: float = 0.6,
                   perturb: float = 0.3, kd: float = 1.0, settle_max: float = 3.0, rest_speed: float = 0.05,
-                  max_tries: int = 4) -> list[dict]:
-    """``n`` settled rag-doll states on the ground, seeded: ``[{q, qd, style, settle_s}]`` (lists).
+                  max_tries: int = 4, terrain: Optional[dict] = None, region: int = 0,
+                  sim_hz: Optional[float] = None) -> list[dict]:
+    """``n`` settled rag-doll states on the ground, seeded: ``[{q, qd, style, settle_s, at_rest,
+    region, xz}]`` (lists).
 
     Args:
         sim_groups: ``{"sim", "spd", "character"}`` plain groups (the env's; PD servos switched off here).
@@ -114,36 +119,59 @@ def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = S
         settle_max: s of simulation allowed to come to rest (notes: drops settle within 3 s).
         rest_speed: at rest when every generalised speed is below this (rad/s, m/s).
         max_tries: drops per state before the last one is accepted as it is.
+        terrain: a ``terrain.TerrainSpec`` dict: the terrain is built and each drop lands at a
+            seeded location of ``region`` (003 §5.2 "onto the terrain at various locations");
+            None or region 0: dropped at the origin of the flat ground.
+        region: the terrain region (0 flat .. 3 hard).
+        sim_hz: the drops' simulation rate (None: the env's); a passive rag-doll settles the same
+            at 60-600 Hz (notes), so a low rate makes drops cheap.
+
+    A drop the simulator flags as failed (exploded) is never accepted: it is drawn again, up to
+    ``3 * max_tries`` times, then ``RuntimeError``.
     """
     from jt_tasks.policy.env import load_simulator
 
     if n <= 0:
         return []
+    from jt_tasks.getup import terrain as T
+
     rng = np.random.default_rng(int(seed))
-    sim = load_simulator(passive_groups(sim_groups, kd))
+    sim = load_simulator(passive_groups(sim_groups, kd, sim_hz))
     q_stand, _ = clip_pose("getup_facedown", False, frame=-1)
+    tspec = T.TerrainSpec.from_dict(terrain) if terrain is not None and region > 0 else None
+    if tspec is not None:
+        T.add_terrain(sim, tspec, float((sim_groups.get("sim") or {}).get("friction", 1.0)))
+        where = T.sample_locations(tspec, int(region), n, np.random.default_rng([int(seed), int(region)]))
     out = []
     try:
         steps = int(round(settle_max * float(sim.params.control_hz)))
         for i in range(n):
             style = styles[i % len(styles)]
-            for attempt in range(max_tries):
+            xz = where[i] if tspec is not None else np.zeros(2)
+            for attempt in range(3 * max_tries):
                 q0 = perturb_joints(lay_down(q_stand, style, rng.uniform(-math.pi, math.pi), 1.0), rng, perturb)
-                q0 = lift_to_ground(q0, 0.0, drop_height)
+                if tspec is not None:
+                    q0 = T.place_on_ground(sim, q0, np.zeros(sim.model.n_v), xz, drop_height)
+                else:
+                    q0 = lift_to_ground(q0, 0.0, drop_height)
                 sim.reset(q0, np.zeros(sim.model.n_v))
-                rest, t = False, 0.0
+                rest, failed, t = False, False, 0.0
                 for k in range(steps):
                     q, qd = sim.state()
                     rec = sim.step(q)
                     t = (k + 1) / float(sim.params.control_hz)
                     if rec["failed"]:
+                        failed = True
                         break
                     if k > 3 and float(np.max(np.abs(rec["qd"]))) < rest_speed:
                         rest = True
                         break
-                if rest or attempt == max_tries - 1:
+                if failed and attempt == 3 * max_tries - 1:
+                    raise RuntimeError(f"fallen_states: every drop of state {i} failed ({rec['reason']})")
+                if not failed and (rest or attempt >= max_tries - 1):
                     q, qd = sim.state()
-                    out.append({"q": q.tolist(), "qd": qd.tolist(), "style": style, "settle_s": t, "at_rest": rest})
+                    out.append({"q": q.tolist(), "qd": qd.tolist(), "style": style, "settle_s": t, "at_rest": rest,
+                                "region": int(region) if tspec is not None else 0, "xz": [float(v) for v in xz]})
                     break
     finally:
         sim.close()

@@ -1,0 +1,155 @@
+"""The ``task`` group of ``task=getup`` (``003``; docs/getup.md): every default with its source.
+
+``jt run task=getup --cfg`` prints every value; ``GetupConfig.check`` turns each mistake into one
+``JtError`` line with the valid choices.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Optional
+
+from jt_tasks.getup.terrain import REGIONS, TerrainSpec
+from jt_tasks.policy.task import PolicyConfig
+
+
+@dataclasses.dataclass
+class GetupConfig(PolicyConfig):
+    """The ``task`` group of ``task=getup`` (``jt run task=getup --cfg`` prints every value)."""
+
+    name: str = "getup"
+    """Registry name."""
+    curves: list[str] = dataclasses.field(
+        default_factory=lambda: ["facedown", "facedown_mirror", "faceup", "faceup_mirror"])
+    """Training curves: reference curves of the DeepMimic get-up clips (and mirrors) or names in authored (003 §5.5 uses 13 reference + 5 authored x 3 durations; ours: the 2 clips jt has)."""
+    authored: dict = dataclasses.field(default_factory=dict)
+    """Authored curves {name: {h: [9], theta_x: [9], theta_z: [9], duration: s}} (003 §4.3, §5.5)."""
+    authored_durations: list[float] = dataclasses.field(default_factory=list)
+    """S; each authored curve once per duration (003 §5.5: 2.5, 5.1, 7.6); empty: its own duration."""
+    n_control: int = 9
+    """Control points per curve (003 §4.1: "nine control points are sufficient")."""
+    extraction: str = "sample"
+    """Reference curves: sample (003 §4.1, the features at 9 instants) or lstsq (ours: a least-squares fit)."""
+    clamped: bool = True
+    """Clamped end knots, uniform inside (ours, jt's splines: the curve starts and ends at its end points); false: unclamped cardinal."""
+    t_stand: float = 3.0
+    """S of standing after T in every episode (003 §5.6: T_stand = 3 s)."""
+    p_standing: float = 0.1
+    """Share of episodes starting standing (003 §5.2 "necessary"; the share is ours)."""
+    p_fallen: float = 0.3
+    """Share of episodes starting from a rag-doll state (003 §5.2; the share is ours); the rest start at the curve's clip's first pose (003 §5.5)."""
+    n_fallen: int = 8
+    """Rag-doll states generated per evaluation (ours)."""
+    fallen_styles: list[str] = dataclasses.field(default_factory=lambda: ["prone", "supine"])
+    """Rag-doll drop postures (003 §5.2: prone or supine)."""
+    fallen_seed: int = 0
+    """Seed of the rag-doll generator (ours)."""
+    drop_height: float = 0.6
+    """M, lowest point at release (ours)."""
+    drop_perturb: float = 0.3
+    """Rad, random joint perturbation of the drop pose (ours)."""
+    ragdoll_kd: float = 1.0
+    """N m s/rad, joint damping of the passive rag-doll (ours; 003: "passive")."""
+    settle_max: float = 3.0
+    """S allowed to come to rest (ours; drops settle within 3 s, notes)."""
+    rest_speed: float = 0.05
+    """At rest when every generalised speed is below this (ours)."""
+    drop_hz: Optional[float] = 120.0
+    """Hz, simulation rate of the rag-doll drops (ours: a passive rag-doll settles alike at 60-600 Hz, and 5x fewer substeps than the env's 600 Hz make drops cheap); null: the env's."""
+    curve_match_deg: float = 30.0
+    """A rag-doll start takes a curve whose start torso angles are within this (003 §5.2: 30°)."""
+    r_task_min: float = 0.1
+    """Early termination when r_task stays below this (003 §5.3)."""
+    sustain: float = 0.3
+    """S an early-termination condition must last (003 §5.3: 300 ms)."""
+    head_grace: float = 1.0
+    """S after a start with the head on the floor (supine, rag-doll) during which head contacts do not count (ours; 003 §5.3 has none)."""
+    friction: Optional[float] = 1.0
+    """Ground and link friction set on the simulator (003 §3.2: mu = 1.0); null: the sim group's."""
+    success_height: float = 0.8
+    """Standing = neck height >= this x p_h(1) (ours; 003 §6.3 gives no threshold)."""
+    success_window: float = 1.0
+    """S standing at the end of the episode that make a success (ours)."""
+    heightmap_n: int = 5
+    """Height-map samples per side (003 §3.3.2: 5 x 5)."""
+    heightmap_spacing: float = 0.25
+    """M between height-map samples (003 §3.2: 25 cm over 1 m)."""
+    terrain: dict = dataclasses.field(default_factory=lambda: TerrainSpec().to_dict())
+    """The terrain world (003 §3.2, §5.4, Fig. 3; jt_tasks.getup.terrain): four size x size m regions flat/easy/medium/hard along x, each harder one half rough (1 m tiles, 003 §3.2; heights uniform in [0, roughness] m, ours) and half sloped (a triangle wave of slope_deg, the steepest 30° as 003 §6.5; the others ours), seeded; {} = flat ground only."""
+    train_regions: str = "curriculum"
+    """Regions with training rag-doll states: curriculum (all four when curriculum=terrain, else flat only) or flat (ours)."""
+    eval_regions: list[str] = dataclasses.field(default_factory=lambda: list(REGIONS))
+    """Regions of the Table 1 evaluation (003 §6.3, Table 1: flat, easy, medium, hard)."""
+    eval_locations: int = 100
+    """Rag-doll drops at seeded locations per evaluated region, one deterministic get-up each (003 §6.3: 100 terrain locations)."""
+    eval_seed: int = 1
+    """Seed of the evaluation's drops and locations (ours; differs from fallen_seed so they are not the training states)."""
+    natural_terms: list[str] = dataclasses.field(default_factory=lambda: ["naturalness"])
+    """Reward terms that make r_natural (003 eq 2); the others multiply to r_task (eq 4)."""
+    eval_curve: str = "facedown"
+    """Curve of the deterministic rollout (from its clip's first pose)."""
+    eval_episodes: int = 4
+    """Deterministic evaluation get-ups (the rollout, then the other curves' clip starts and rag-doll states in turn) giving success_rate (ours)."""
+    time_scale: float = 1.0
+    """Default of the searched point: every curve's T times this (003 §4.3)."""
+
+    def check(self) -> None:
+        """One-line ``JtError`` for each mistake (unknown curve or style, control-point count ...)."""
+        from toolkit.schema import finite, require
+
+        from jt_tasks.getup.curves import build_curves
+        from jt_tasks.getup.initial import STYLES
+
+        require(self.n_control >= 4, "task.n_control", self.n_control, "a cubic B-spline needs >= 4 control points")
+        require(self.extraction in ("sample", "lstsq"), "task.extraction", self.extraction, "sample or lstsq")
+        require(bool(self.curves), "task.curves", self.curves, "needs at least one curve")
+        for d in self.authored_durations:
+            require(finite(d) and float(d) > 0, "task.authored_durations", list(self.authored_durations),
+                    "durations must be > 0 s")
+        try:
+            build_curves(list(self.curves), dict(self.authored), list(self.authored_durations) or None,
+                         self.n_control, self.extraction, self.clamped)
+        except (KeyError, ValueError) as e:
+            require(False, "task.curves", list(self.curves), str(e.args[0] if e.args else e))
+        bad = [s for s in self.fallen_styles if s not in STYLES]
+        require(not bad and bool(self.fallen_styles), "task.fallen_styles", list(self.fallen_styles),
+                f"each one of {', '.join(STYLES)}")
+        require(self.eval_curve in self.curves, "task.eval_curve", self.eval_curve,
+                f"must be one of task.curves ({', '.join(self.curves)})")
+        require(self.eval_episodes >= 1, "task.eval_episodes", self.eval_episodes, "must be >= 1")
+        require(self.n_fallen >= 0, "task.n_fallen", self.n_fallen, "must be >= 0")
+        for key in ("p_standing", "p_fallen"):
+            v = getattr(self, key)
+            require(finite(v) and 0.0 <= v <= 1.0, f"task.{key}", v, "must be in [0, 1]")
+        require(self.p_standing + self.p_fallen <= 1.0, "task.p_standing+p_fallen",
+                self.p_standing + self.p_fallen, "must be <= 1")
+        for key in ("t_stand", "sustain", "settle_max", "time_scale", "heightmap_spacing", "success_height"):
+            v = getattr(self, key)
+            require(finite(v) and v > 0, f"task.{key}", v, "must be a finite number > 0")
+        for key in ("head_grace", "success_window", "r_task_min", "drop_height", "drop_perturb", "ragdoll_kd",
+                    "rest_speed"):
+            v = getattr(self, key)
+            require(finite(v) and v >= 0, f"task.{key}", v, "must be a finite number >= 0")
+        if self.terrain:
+            try:
+                bad = TerrainSpec.from_dict(dict(self.terrain)).check()
+            except TypeError as e:
+                bad = [str(e)]
+            require(not bad, "task.terrain", dict(self.terrain), "; ".join(bad))
+        require(self.train_regions in ("curriculum", "flat"), "task.train_regions", self.train_regions,
+                "curriculum or flat")
+        unknown = [r for r in self.eval_regions if r not in REGIONS]
+        require(not unknown, "task.eval_regions", list(self.eval_regions), f"each one of {', '.join(REGIONS)}")
+        require(bool(self.terrain) or all(r == "flat" for r in self.eval_regions), "task.eval_regions",
+                list(self.eval_regions), "only flat without a terrain (task.terrain={})")
+        require(isinstance(self.eval_locations, int) and self.eval_locations >= 1, "task.eval_locations",
+                self.eval_locations, "an integer >= 1 (task.eval_regions=[] skips the Table 1 evaluation)")
+        require(self.drop_hz is None or (finite(self.drop_hz) and self.drop_hz >= 30.0), "task.drop_hz", self.drop_hz,
+                "null or >= 30 Hz")
+        require(self.heightmap_n >= 1, "task.heightmap_n", self.heightmap_n, "must be >= 1")
+        require(0.0 < self.curve_match_deg <= 180.0, "task.curve_match_deg", self.curve_match_deg, "in (0, 180]")
+        require(self.friction is None or (finite(self.friction) and self.friction >= 0), "task.friction",
+                self.friction, "null or >= 0")
+        require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
+                "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,
+                                                       self.filmstrip_height), "frames >= 0, sizes > 0")

@@ -1,0 +1,112 @@
+"""The robustness evaluation of ``003`` §6.3 / Table 1 and the feature-curve plot.
+
+Table 1: "we evaluate the robustness of the trained policy by starting from 100 different terrain
+locations and tracking the success of the agent" (§6.3), per region (flat, easy, medium, hard) and
+overall. Here: for each region of ``task.eval_regions``, ``task.eval_locations`` passive rag-doll
+drops at seeded locations of the region (``task.eval_seed``, never the training states' seed), one
+deterministic get-up from each (the curve picked by the 30° rule of §5.2, seeded), and per region:
+
+* ``success_<region>``: share of successes (``GetupEnv``: not terminated early and standing for
+  the last ``success_window`` s, §6.3 "remains standing after getting up"); ``success_overall``
+  over all the evaluated episodes (Table 1's "Overall");
+* ``rise_<region>``: share that reached the standing height at some point (``got_up``);
+* ``time_to_rise_<region>``: mean s from the start to the first standing height, over those that rose;
+* ``return_rate_<region>``: mean task return rate (Σ r_task / the episode's steps, §6.4);
+* ``early_<region>``: share terminated early (§5.3).
+
+``table1.h5`` holds one row per episode (region, location, style, curve, each column above).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from jt_tasks.getup.terrain import REGIONS
+
+COLUMNS = ("success", "got_up", "time_to_rise", "task_return_rate", "early")  #: per-episode values
+
+
+def evaluate_regions(task: Any, spec: Any, model: Any) -> dict[str, dict[str, np.ndarray]]:
+    """One deterministic get-up per evaluation drop of each region: ``{region: {column: (n,)}}``
+    plus ``x``, ``z``, ``style`` (0 prone, 1 supine) and ``curve`` per episode."""
+    from jt_tasks.policy.train import rollout
+
+    p = task.params
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for name in p.eval_regions:
+        region = REGIONS.index(name)
+        states = task.fallen(spec.sim, [region], p.eval_locations, p.eval_seed)
+        env = task.env_class(dataclasses.replace(spec, fallen=states), seed=0)
+        env.terrain_level = region
+        rows = []
+        try:
+            for i, st in enumerate(states):
+                info = rollout(env, model, lambda e: {}, 0, 1, 1, {"kind": "fallen", "fallen": i})["info"]
+                rows.append({"success": info.get("success", 0.0), "got_up": info.get("got_up", 0.0),
+                             "time_to_rise": info.get("time_to_rise", math.nan),
+                             "task_return_rate": info.get("task_return_rate", 0.0),
+                             "early": float(info.get("reason", "") not in ("time limit",)),
+                             "x": st["xz"][0], "z": st["xz"][1], "style": float(st["style"] == "supine"),
+                             "curve": info.get("curve", math.nan)})
+        finally:
+            env.close()
+        out[name] = {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else {}
+    return out
+
+
+def table_metrics(table: dict[str, dict[str, np.ndarray]]) -> dict[str, float]:
+    """Table 1's figures from ``evaluate_regions``: per region and ``success_overall``."""
+    out: dict[str, float] = {}
+    for name, cols in table.items():
+        if not cols:
+            continue
+        out[f"success_{name}"] = float(np.mean(cols["success"]))
+        out[f"rise_{name}"] = float(np.mean(cols["got_up"]))
+        rose = cols["time_to_rise"][np.isfinite(cols["time_to_rise"])]
+        if len(rose):
+            out[f"time_to_rise_{name}"] = float(np.mean(rose))
+        out[f"return_rate_{name}"] = float(np.mean(cols["task_return_rate"]))
+        out[f"early_{name}"] = float(np.mean(cols["early"]))
+    every = [cols["success"] for cols in table.values() if cols]
+    if every:
+        out["success_overall"] = float(np.mean(np.concatenate(every)))
+    return out
+
+
+def write_table(path: Path, table: dict[str, dict[str, np.ndarray]], metrics: dict[str, float]) -> None:
+    """``table1.h5``: a group per region with one row per episode; the table's figures as attributes."""
+    from toolkit.store import h5
+
+    data = {name: cols for name, cols in table.items() if cols}
+    attrs = {k: v for k, v in metrics.items() if k.split("_")[0] in ("success", "rise", "time", "return", "early")}
+    attrs["regions"] = ",".join(data)
+    h5.write(path, data, attrs)
+
+
+def plot_curves(path: Path, time: np.ndarray, features: np.ndarray, targets: np.ndarray, title: str = "") -> None:
+    """``curves.png``: the features achieved (solid) against the curve's targets (dashed) over the
+    rollout: h (m), θx and θz (deg)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(10, 2.8))
+    labels = ("h (m)", "θx (deg)", "θz (deg)")
+    for k, ax in enumerate(axes):
+        scale = 1.0 if k == 0 else 180.0 / math.pi
+        ax.plot(time, features[:, k] * scale, label="achieved")
+        ax.plot(time, targets[:, k] * scale, "--", label="target")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel(labels[k])
+    axes[0].legend(fontsize=7)
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)

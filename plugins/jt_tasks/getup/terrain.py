@@ -1,0 +1,167 @@
+"""The get-up terrain: one world of four regions, flat → easy → medium → hard (``003`` §3.2, §5.4, Fig. 3).
+
+``003`` §5.4: "the same terrain is used for all experiments, but it is divided into four regions
+(flat, easy, medium, and hard difficulties)"; §3.2: "rough terrain variations are created by
+perturbing the height of 1.0 m × 1.0 m tiles of a flat terrain"; Fig. 3: each harder region has
+rough and sloped parts; §6.5: the steepest slope is 30°. The amplitudes are not given; ours:
+
+* region ``k`` is a ``size`` × ``size`` square centred at ``(k · size, ·, 0)`` (x along the regions,
+  y up); region 0 (flat) is the simulator's ground plane at the origin, where the clips' poses lie;
+* regions ``k ≥ 1`` are one static heightfield (``sim.add_heightfield``, cell ``cell``): the half
+  ``z < 0`` **rough**, 1 m tiles with heights uniform in ``[0, roughness[k]]`` (seeded), the half
+  ``z ≥ 0`` **sloped**, a triangle wave along x of slope ``slope_deg[k]`` and period ``slope_period``
+  (ridges and valleys parallel to z);
+* start locations are drawn uniformly in a region, ``margin`` m from its borders (steps between
+  regions and halves are never under a start).
+
+Everything is a function of the spec and its ``seed``: the same seed gives the same heights.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Optional
+
+import numpy as np
+
+REGIONS = ("flat", "easy", "medium", "hard")  #: 003 §5.4, Table 1's columns
+
+
+@dataclasses.dataclass
+class TerrainSpec:
+    """The terrain world (every field picklable; ``GetupConfig.terrain`` documents each)."""
+
+    size: float = 8.0
+    cell: float = 0.125
+    tile: float = 1.0  # 003 §3.2: 1.0 m x 1.0 m tiles
+    roughness: tuple = (0.0, 0.04, 0.08, 0.12)
+    slope_deg: tuple = (0.0, 10.0, 20.0, 30.0)  # 003 §6.5: the steepest 30°
+    slope_period: float = 4.0
+    margin: float = 1.5
+    seed: int = 0
+
+    @classmethod
+    def from_dict(cls, d: Optional[dict]) -> "TerrainSpec":
+        d = dict(d or {})
+        for k in ("roughness", "slope_deg"):
+            if k in d:
+                d[k] = tuple(float(v) for v in d[k])
+        return cls(**{k: v for k, v in d.items() if k in {f.name for f in dataclasses.fields(cls)}})
+
+    def to_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in dataclasses.asdict(self).items()}
+
+    @property
+    def n_regions(self) -> int:
+        return len(self.roughness)
+
+    def check(self) -> list[str]:
+        """Problems with the spec, one sentence each (empty: none)."""
+        bad = []
+        if len(self.roughness) != len(REGIONS) or len(self.slope_deg) != len(REGIONS):
+            bad.append(f"roughness and slope_deg need {len(REGIONS)} values ({', '.join(REGIONS)})")
+        if any(not (0.0 <= r < 1.0) for r in self.roughness):
+            bad.append("roughness values must be in [0, 1) m")
+        if any(not (0.0 <= s < 60.0) for s in self.slope_deg):
+            bad.append("slope_deg values must be in [0, 60)")
+        if not (self.cell > 0 and self.tile >= self.cell and self.slope_period > 0):
+            bad.append("need cell > 0, tile >= cell, slope_period > 0")
+        if not (0.0 <= self.margin < self.size / 2):
+            bad.append("need 0 <= margin < size / 2")
+        return bad
+
+
+def region_centre(spec: TerrainSpec, region: int) -> np.ndarray:
+    """``(x, z)`` of region ``region``'s centre."""
+    return np.array([region * spec.size, 0.0])
+
+
+def region_of(spec: TerrainSpec, x: Any) -> np.ndarray:
+    """Region index of world ``x`` (region 0 is everything left of the first heightfield)."""
+    k = np.floor(np.asarray(x, float) / spec.size + 0.5).astype(int)
+    return np.clip(k, 0, spec.n_regions - 1)
+
+
+def _tile_heights(spec: TerrainSpec) -> np.ndarray:
+    """Seeded tile heights ``(n_regions, tiles, tiles)``: uniform in ``[0, roughness[k]]``."""
+    n = int(math.ceil(spec.size / spec.tile)) + 1
+    rng = np.random.default_rng(int(spec.seed))
+    u = rng.random((spec.n_regions, n, n))
+    return u * np.asarray(spec.roughness, float)[:, None, None]
+
+
+def heights_at(spec: TerrainSpec, x: Any, z: Any, tiles: Optional[np.ndarray] = None) -> np.ndarray:
+    """The designed terrain height (m) at world points ``(x, z)`` (same shapes): 0 on region 0 and
+    outside the world, tile heights on rough halves, the triangle wave on sloped halves. The
+    heightfield samples this at its grid points (between them PyBullet interpolates)."""
+    x, z = np.broadcast_arrays(np.asarray(x, float), np.asarray(z, float))
+    tiles = _tile_heights(spec) if tiles is None else tiles
+    k = region_of(spec, x)
+    lx = x - k * spec.size + spec.size / 2  # region-local, in [0, size)
+    lz = z + spec.size / 2
+    inside = (k >= 1) & (lz >= 0) & (lz <= spec.size) & (x >= spec.size / 2) & \
+        (x <= (spec.n_regions - 0.5) * spec.size)
+    ix = np.clip((lx // spec.tile).astype(int), 0, tiles.shape[1] - 1)
+    iz = np.clip((lz // spec.tile).astype(int), 0, tiles.shape[2] - 1)
+    rough = tiles[k, ix, iz]
+    half = spec.slope_period / 2
+    tri = half - np.abs(np.mod(lx, spec.slope_period) - half)  # 0 at valleys, half at ridges
+    slope = np.tan(np.radians(np.asarray(spec.slope_deg, float)))[k] * tri
+    return np.where(inside, np.where(z < 0.0, rough, slope), 0.0)
+
+
+def grid(spec: TerrainSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(xs (n_x,), zs (n_z,), heights (n_x, n_z))`` of the heightfield over regions 1..n−1."""
+    x0, x1 = spec.size / 2, (spec.n_regions - 0.5) * spec.size
+    n_x = int(round((x1 - x0) / spec.cell)) + 1
+    n_z = int(round(spec.size / spec.cell)) + 1
+    xs = x0 + spec.cell * np.arange(n_x)
+    zs = -spec.size / 2 + spec.cell * np.arange(n_z)
+    gx, gz = np.meshgrid(xs, zs, indexing="ij")
+    return xs, zs, heights_at(spec, gx, gz)
+
+
+def add_terrain(sim: Any, spec: TerrainSpec, friction: float = 1.0) -> int:
+    """Build the regions ``1..n−1`` on ``sim`` as one heightfield (``sim.add_heightfield``); its handle.
+    ``friction``: 003 §3.2, μ = 1.0."""
+    xs, zs, h = grid(spec)
+    origin = (0.5 * (xs[0] + xs[-1]), 0.0, 0.5 * (zs[0] + zs[-1]))
+    return int(sim.add_heightfield(h, spec.cell, origin, friction=friction))
+
+
+def sample_locations(spec: TerrainSpec, region: int, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` start locations ``(n, 2)`` (x, z), uniform in region ``region`` ``margin`` m inside its
+    borders, and (regions ≥ 1) ``margin`` / 2 from the rough/sloped seam at z = 0."""
+    c = region_centre(spec, region)
+    half = spec.size / 2 - spec.margin
+    x = c[0] + rng.uniform(-half, half, n)
+    z = rng.uniform(-half, half, n)
+    if region >= 1:  # keep off the seam between the rough and the sloped halves
+        gap = spec.margin / 2
+        z = np.where(z < 0, np.minimum(z, -gap), np.maximum(z, gap))
+    return np.stack([x, z], axis=1)
+
+
+def place_on_ground(sim: Any, q: np.ndarray, qd: np.ndarray, xz: Any, clearance: float = 0.005) -> np.ndarray:
+    """``q`` moved to ``(x, z)`` = ``xz`` and raised so that every link's box is ``clearance`` above
+    the terrain under its centre and four lower corners (rays through ``sim``, which is left in the
+    placed state); the pose's orientation is kept."""
+    q = np.array(q, dtype=np.float64)
+    q[0], q[2] = float(xz[0]), float(xz[1])
+    q[1] += 2.0  # well clear of any terrain while measuring
+    sim.reset(q, np.asarray(qd, float))
+    lows, starts = [], []
+    for link in range(-1, int(sim.n_links)):
+        lo, hi = sim.aabb(link)
+        lows.append(float(lo[1]))
+        for fx, fz in ((0.5, 0.5), (0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)):
+            starts.append([lo[0] + fx * (hi[0] - lo[0]), 50.0, lo[2] + fz * (hi[2] - lo[2])])
+    starts = np.asarray(starts)
+    ends = starts.copy()
+    ends[:, 1] = -50.0
+    ground = sim.ray(starts, ends)[:, 1].reshape(len(lows), -1)
+    ground = np.where(np.isfinite(ground), ground, 0.0).max(axis=1)
+    q[1] += float(np.max(ground + clearance - np.asarray(lows)))
+    sim.reset(q, np.asarray(qd, float))
+    return q

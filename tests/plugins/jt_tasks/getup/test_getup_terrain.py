@@ -1,0 +1,139 @@
+"""The get-up terrain (003 §3.2, §5.4): real heightfield regions, seeded; the height map and h follow it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from getup_helpers import sim_groups
+from jt_tasks.getup import terrain as T
+from toolkit.errors import JtError
+
+
+@pytest.fixture(scope="module")
+def world():
+    """A bullet simulator holding the default terrain."""
+    from jt_tasks.policy.env import load_simulator
+
+    sim = load_simulator(sim_groups())
+    spec = T.TerrainSpec()
+    T.add_terrain(sim, spec)
+    yield sim, spec
+    sim.close()
+
+
+def down_rays(xz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    starts = np.stack([xz[:, 0], np.full(len(xz), 20.0), xz[:, 1]], axis=1)
+    ends = starts.copy()
+    ends[:, 1] = -1.0
+    return starts, ends
+
+
+def test_regions_are_rough_and_sloped_as_designed_and_seeded():
+    spec = T.TerrainSpec()
+    a, b = T.grid(spec)[2], T.grid(T.TerrainSpec())[2]
+    np.testing.assert_array_equal(a, b)  # same seed, same heights
+    assert not np.array_equal(a, T.grid(T.TerrainSpec(seed=1))[2])
+    rng = np.random.default_rng(0)
+    for region in range(1, 4):
+        xz = T.sample_locations(spec, region, 400, rng)
+        assert np.all(T.region_of(spec, xz[:, 0]) == region)
+        h = T.heights_at(spec, xz[:, 0], xz[:, 1])
+        rough, slope = h[xz[:, 1] < 0], h[xz[:, 1] > 0]
+        assert 0.0 <= rough.min() and rough.max() <= spec.roughness[region] + 1e-12
+        assert np.ptp(rough) > 0.5 * spec.roughness[region]  # really perturbed tiles
+        top = math.tan(math.radians(spec.slope_deg[region])) * spec.slope_period / 2
+        assert slope.max() <= top + 1e-12 and slope.max() > 0.5 * top
+    flat = T.heights_at(spec, *T.sample_locations(spec, 0, 100, rng).T)
+    assert np.all(flat == 0.0)
+
+
+def test_heightfield_in_pybullet_matches_the_design(world):
+    sim, spec = world
+    rng = np.random.default_rng(1)
+    for region in range(1, 4):
+        xz = T.sample_locations(spec, region, 200, rng)
+        # rough: tile centres (flat tops); sloped: anywhere on a face
+        rough = xz[xz[:, 1] < 0]
+        rough = (np.floor((rough - [region * spec.size - spec.size / 2, -spec.size / 2]) / spec.tile) + 0.5) \
+            * spec.tile + [region * spec.size - spec.size / 2, -spec.size / 2]
+        for pts in (rough, xz[xz[:, 1] > 0]):
+            hit = sim.ray(*down_rays(pts))[:, 1]
+            np.testing.assert_allclose(hit, T.heights_at(spec, pts[:, 0], pts[:, 1]), atol=2e-3)
+
+
+def test_hard_slope_is_30_degrees(world):
+    sim, spec = world
+    x0 = 3 * spec.size - spec.size / 2 + 0.5  # inside the first up-slope of the hard region
+    hits = sim.ray(*down_rays(np.array([[x0, 2.0], [x0 + 1.0, 2.0]])))[:, 1]
+    assert math.degrees(math.atan2(hits[1] - hits[0], 1.0)) == pytest.approx(30.0, abs=0.5)  # 003 §6.5
+
+
+def test_height_map_and_h_follow_the_terrain(world):
+    from jt_tasks.getup import features as F
+    from jt_tasks.getup.initial import clip_pose
+
+    sim, spec = world
+    q, qd = clip_pose("getup_facedown", False, frame=-1)  # standing
+    grounds = {}
+    for region in (0, 3):
+        xz = T.sample_locations(spec, region, 1, np.random.default_rng(5))[0]
+        xz[1] = -abs(xz[1])  # the rough half
+        T.place_on_ground(sim, q, qd, xz)
+        m = F.measure(sim)
+        pts = F.heightmap_points(0.5 * (m["r_hip"] + m["l_hip"]), m["yaw"])
+        np.testing.assert_allclose(m["ground"], T.heights_at(spec, pts[:, 0], pts[:, 2]), atol=0.03)
+        assert m["features"][0] == pytest.approx(m["neck"][1] - m["ground"].mean())
+        grounds[region] = m["ground"]
+    assert np.all(grounds[0] == pytest.approx(0.0, abs=1e-6))
+    assert np.ptp(grounds[3]) > 0.02 and grounds[3].mean() > 0.01  # not flat under the character
+
+
+def test_rag_doll_drops_land_on_the_terrain_at_seeded_locations():
+    from jt_tasks.getup.initial import fallen_states, lowest_point
+
+    spec = T.TerrainSpec()
+    kw = dict(styles=("prone",), settle_max=1.0, max_tries=1, terrain=spec.to_dict(), region=2)
+    a = fallen_states(sim_groups(), 1, 7, **kw)
+    b = fallen_states(sim_groups(), 1, 7, **kw)
+    assert a[0]["q"] == b[0]["q"] and a[0]["region"] == 2
+    x, z = a[0]["xz"]
+    assert T.region_of(spec, x) == 2 and abs(a[0]["q"][0] - x) < 1.0 and abs(a[0]["q"][2] - z) < 1.0
+    under = T.heights_at(spec, x, z)
+    assert lowest_point(np.asarray(a[0]["q"])) < float(under) + 0.15  # lying on the terrain, not floating
+
+
+def test_curriculum_level_bounds_the_regions_visited():
+    from toolkit import plugins
+    from toolkit.config import compose, validate
+
+    cfg = validate(compose(["task=getup", "action=raw", "task.n_fallen=1", "task.settle_max=0.5"]))
+    task = plugins.load("task", "getup")(cfg)
+    assert task.train_regions() == [0, 1, 2, 3]
+    env = task.make_env(None, seed=0)
+    try:
+        env.terrain_level = 1
+        regions = {env.reset(seed=s)[1]["terrain_level"] for s in range(40)}
+        assert regions == {0.0, 1.0}  # every unlocked region visited, nothing beyond (003 §5.4)
+        _, info = env.reset(options={"region": 3, "kind": "standing"})
+        assert info["terrain_level"] == 3.0 and T.region_of(T.TerrainSpec(), env.sim.state()[0][0]) == 3
+        _, info = env.reset(options={"region": 2})
+        assert info["start_kind"] in (1.0, 2.0)  # no clip poses on irregular ground (003 §5.2)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("override, match", [
+    ("task.eval_regions=[flat,steep]", "task.eval_regions"),
+    ("task.eval_locations=0", "task.eval_locations"),
+    ("task.terrain.roughness=[0,0.1]", "task.terrain"),
+    ("task.train_regions=all", "task.train_regions"),
+])
+def test_bad_terrain_input_is_one_line(override, match):
+    from toolkit.config import compose, validate
+
+    with pytest.raises(JtError, match=match) as e:
+        validate(compose(["task=getup", "action=raw", override]))
+    assert "\n" not in str(e.value)
