@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Optional
 
+from jt_tasks.getup.styles import STYLES as AUTHORED_STYLES
 from jt_tasks.getup.terrain import REGIONS, TerrainSpec
 from jt_tasks.policy.task import PolicyConfig
 
@@ -20,12 +21,12 @@ class GetupConfig(PolicyConfig):
     name: str = "getup"
     """Registry name."""
     curves: list[str] = dataclasses.field(
-        default_factory=lambda: ["facedown", "facedown_mirror", "faceup", "faceup_mirror"])
-    """Training curves: reference curves of the DeepMimic get-up clips (and mirrors) or names in authored (003 §5.5 uses 13 reference + 5 authored x 3 durations; ours: the 2 clips jt has)."""
+        default_factory=lambda: ["facedown", "facedown_mirror", "faceup", "faceup_mirror", *AUTHORED_STYLES])
+    """Training curves: reference curves of the DeepMimic get-up clips (and mirrors), the 5 built-in authored styles (jt_tasks.getup.styles, docs/getup.md) or names in authored (003 §5.5: 13 reference + 5 authored x 3 durations = 28; ours: 4 + 5 x 3 = 19)."""
     authored: dict = dataclasses.field(default_factory=dict)
-    """Authored curves {name: {h: [9], theta_x: [9], theta_z: [9], duration: s}} (003 §4.3, §5.5)."""
-    authored_durations: list[float] = dataclasses.field(default_factory=list)
-    """S; each authored curve once per duration (003 §5.5: 2.5, 5.1, 7.6); empty: its own duration."""
+    """More authored curves, or overrides of the built-in styles: {name: {h: [9], theta_x: [9], theta_z: [9] (rad), duration: s}} (003 §4.3, §5.5)."""
+    authored_durations: list[float] = dataclasses.field(default_factory=lambda: [2.5, 5.1, 7.6])
+    """S; each authored curve once per duration (003 §5.5: 2.5, 5.1, 7.6 s); empty: its own duration (5.1 s for the built-in styles)."""
     n_control: int = 9
     """Control points per curve (003 §4.1: "nine control points are sufficient")."""
     extraction: str = "sample"

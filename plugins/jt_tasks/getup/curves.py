@@ -148,21 +148,25 @@ def replay_score(curve: FeatureCurve) -> dict[str, float]:
 def build_curves(names: list[str], authored: dict, durations: Optional[list], n_control: int = N_CONTROL,
                  extraction: str = "sample", clamped: bool = True, time_scale: float = 1.0) -> list[FeatureCurve]:
     """The training set of curves: each named one (a reference curve, else an authored one from
-    ``authored[name] = {h: [...], theta_x: [...], theta_z: [...], duration: T}``), authored curves
+    ``authored[name] = {h: [...], theta_x: [...], theta_z: [...], duration: T}``, else one of the
+    built-in authored styles ``styles.STYLES``, which ``authored`` may override), authored curves
     once per entry of ``durations`` when given (§5.5: 2.5, 5.1, 7.6 s), all durations × ``time_scale``.
 
     Raises:
         KeyError / ValueError: an unknown name, a wrong control-point count (``Config.check`` turns
         them into one-line ``JtError`` s at composition).
     """
+    from jt_tasks.getup.styles import authored_styles
+
+    authored = {**authored_styles(), **dict(authored or {})}
     out = []
     for name in names:
         if name in REFERENCE:
             out.append(reference_curve(name, n_control, extraction, clamped).scaled(time_scale))
             continue
         if name not in authored:
-            raise KeyError(f"unknown curve {name!r}: reference curves are {', '.join(REFERENCE)}; "
-                           f"authored: {', '.join(sorted(authored)) or 'none'}")
+            raise KeyError(f"unknown curve or style {name!r}: reference curves are {', '.join(REFERENCE)}; "
+                           f"authored styles: {', '.join(sorted(authored))}")
         spec = dict(authored[name])
         cols = []
         for f in FEATURES:
