@@ -66,3 +66,12 @@ def test_bad_input_is_one_line_error_at_composition(override, match):
     with pytest.raises(JtError, match=match) as e:
         task(override)
     assert "\n" not in str(e.value)
+
+
+def test_quick_and_paper_presets_compose_with_the_papers_batch():
+    _, quick = task("experiment=quick")
+    _, paper = task("experiment=paper")
+    assert quick.agent.samples_per_iteration == paper.agent.samples_per_iteration == 4096  # 002 §5
+    assert quick.agent.total_samples == 3 * 4096 and quick.task.filmstrip_frames > 0
+    assert paper.agent.total_samples == 6000 * 4096 and list(paper.agent.policy_hidden) == [1024, 512]
+    assert paper.agent.n_workers == 18 and paper.task.eval_time_limit == 20.0
