@@ -21,7 +21,7 @@ import numpy as np
 
 from toolkit import plugins
 from toolkit.errors import JtError
-from toolkit.execution import provenance
+from toolkit.execution import describe, provenance
 from toolkit.execution.evaluate import Job, run_job
 from toolkit.execution.history import History, Record
 from toolkit.execution.seeds import derive
@@ -80,7 +80,8 @@ class _Terminate:
             signal.signal(signal.SIGTERM, self._old)
 
 
-def _open_run(store: Store, cfg: Any, experiment: str) -> tuple[str, bool]:
+def _open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: Any,
+              nested: bool) -> tuple[str, bool]:
     """Start a new outer run, or reopen ``cfg.resume``; returns ``(run_id, resumed)``."""
     from toolkit.config import flatten, to_yaml
 
@@ -91,14 +92,15 @@ def _open_run(store: Store, cfg: Any, experiment: str) -> tuple[str, bool]:
         store.client.update_run(run.info.run_id, status="RUNNING")
         store.set_tags(run.info.run_id, {"jt.resumed": "true"})
         return run.info.run_id, True
+    summary = ((task_cls.__doc__ or "").strip().splitlines() or [""])[0]
+    store.describe_experiment(experiment, describe.experiment(experiment, summary),
+                              {"jt.task": experiment, "jt.kind": "task"})
     tags = {
-        "jt.version": provenance.jt_version(),
-        "jt.git_commit": provenance.git_commit(),
-        "jt.command": provenance.command_line(),
+        **describe.provenance_tags(command),
         "jt.seed": str(cfg.seed),
         "jt.task": str(cfg.task.name),
         "jt.search": str(cfg.search.name),
-        "mlflow.source.name": "jt",
+        describe.NOTE: describe.outer(cfg, command, nested=nested),
     }
     name = cfg.get("run_name") or store.unique_run_name(
         experiment, f"{cfg.task.name}·{cfg.search.name}·seed{cfg.seed}")  # what it is, never a collision
@@ -119,10 +121,19 @@ def _close_stale_children(store: Store, run_id: str, experiment: str) -> None:
         store.end_run(r.info.run_id, "KILLED", "interrupted; re-evaluated when the parent resumed")
 
 
-def run(cfg: Any) -> RunResult:
-    """Run a composed, validated config (see ``toolkit.config.compose``) to completion."""
+def run(cfg: Any, command: Optional[str] = None) -> RunResult:
+    """Run a composed, validated config (see ``toolkit.config.compose``) to completion.
+
+    Args:
+        cfg: the config.
+        command: the command that reproduces the run, for its description (default: this
+            process's command line).
+    """
     from omegaconf import OmegaConf
 
+    from toolkit.priors import auto as auto_prior
+
+    cfg = auto_prior.resolve(cfg)  # action.prior=auto: the store's own prior, trained on first use
     store = Store(store_root(str(cfg.store)))
     task_cls = plugins.load("task", str(cfg.task.name))
     search_cls = plugins.load("search", str(cfg.search.name))
@@ -134,7 +145,8 @@ def run(cfg: Any) -> RunResult:
     nested = bool(getattr(search_cls, "nested", True))
     container = OmegaConf.to_container(cfg, resolve=True)
 
-    run_id, resumed = _open_run(store, cfg, experiment)
+    command = command or provenance.command_line()
+    run_id, resumed = _open_run(store, cfg, experiment, command, task_cls, nested)
     workdir = store.workdir(run_id)
     hist_path = workdir / "search_history.h5"
     _log(f"jt: run {run_id} ({experiment}){' resumed' if resumed else ''}; store {store.root}")
@@ -150,10 +162,13 @@ def run(cfg: Any) -> RunResult:
             executor = exec_cls(cfg.executor)
             try:
                 _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
-                             names, problem, nested, executor, hist_path)
+                             names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
             finally:
                 executor.close()
-            metrics = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
+            metrics, pictures, table = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
+            note = describe.outer(cfg, command, metrics, getattr(task, "key_metrics", ()), pictures, nested,
+                                  describe.table(*table) if table else "")
+            store.set_tags(run_id, {describe.NOTE: note})
         store.end_run(run_id, "FINISHED")
     except KeyboardInterrupt as e:
         store.end_run(run_id, "KILLED", str(e) or "interrupted (Ctrl-C)")
@@ -179,9 +194,11 @@ def _replay(searcher: Any, history: History, batch: int) -> None:
 
 def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experiment: str, task: Any,
                  searcher: Any, history: History, names: list[str], problem: Any, nested: bool,
-                 executor: Any, hist_path: Path) -> None:
+                 executor: Any, hist_path: Path, parent_name: str) -> None:
     budget = int(cfg.search.budget)
     obj_names = list(problem.objective_names)
+    parent_name = parent_name or store.get_run(run_id).info.run_name
+    prefix = str(getattr(task, "curve_prefix", "train/"))
     while not searcher.finished() and len(history) < budget:
         x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
         if len(x) == 0:  # a task with no parameters still has one (empty) point
@@ -203,9 +220,13 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
         evs: list[Optional[Evaluation]] = [None] * len(jobs)
         for j, (ev, secs) in executor.imap(run_job, jobs):
             evs[j] = ev
-            _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs)
+            logged = _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs, prefix)
             history.add(Record(start + j, b, x[j], ev, child_ids[j] if nested else ""))
             if nested:
+                ctx = jobs[j].ctx
+                store.set_tags(child_ids[j], {describe.NOTE: describe.evaluation(
+                    ctx.index, parent_name, jobs[j].point, ctx.seed, ev.metrics, getattr(task, "key_metrics", ()),
+                    logged, ev.reason if ev.failed else "")})
                 store.end_run(child_ids[j], "FINISHED")
             shown = ", ".join(f"{k}={v:.4g}" for k, v in list(ev.metrics.items())[:4])
             _log(f"jt: [{len(history)}/{budget}] eval {start + j} in {secs:.1f}s"
@@ -214,24 +235,44 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
         searcher.tell(x, evs)
 
 
+def curve_key(key: str, prefix: str = "train/") -> str:
+    """The MLflow key of an evaluation's curve ``key``: ``prefix + key`` unless ``key`` already has
+    a namespace (``/``), so a curve never shares its key with the final value of the same name."""
+    return key if "/" in key else f"{prefix}{key}"
+
+
+def _points(series: Any) -> Any:
+    """``(step, value, unix_seconds | None)`` of a curve's points (``(step, value)`` or with a time)."""
+    for point in series:
+        step, value, *rest = point
+        yield int(step), float(value), (float(rest[0]) if rest and rest[0] is not None else None)
+
+
 def _log_evaluation(store: Store, run_id: str, ev: Evaluation, workdir: Path, obj_names: list[str],
-                    secs: float) -> None:
+                    secs: float, prefix: str = "train/") -> list[str]:
+    """Log an evaluation's finals (step 0), curves (``train/<key>``) and files; the files' names."""
     with store.metrics(run_id) as buf:
-        for key, series in ev.history.items():
-            for step, value in series:
-                buf.add(key, value, int(step))
         buf.add_many({**_eval_metrics(ev, obj_names), "eval_seconds": secs})
+        for key, series in ev.history.items():
+            for step, value, when in _points(series):
+                buf.add(curve_key(key, prefix), value, step, when)
     if ev.failed:
         store.set_tags(run_id, {"jt.failure": ev.reason or "failed"})
     if ev.artifacts is None:
         store.log_artifacts(run_id, workdir)
-    else:
-        for name in ev.artifacts:
-            store.log_artifact(run_id, workdir / name)
+        return [str(p.relative_to(workdir)) for p in sorted(Path(workdir).rglob("*")) if p.is_file()]
+    for name in ev.artifacts:
+        store.log_artifact(run_id, workdir / name)
+    return list(ev.artifacts)
 
 
 def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: History, workdir: Path,
-            hist_path: Path, nested: bool) -> dict[str, float]:
+            hist_path: Path, nested: bool) -> tuple[dict[str, float], list[str], Optional[tuple[list, list]]]:
+    """Log the run's summary: metrics, curves, files, the task's summary pictures and table.
+
+    Returns:
+        ``(metrics, picture artifact names, (header, rows) of the summary table or None)``.
+    """
     evs = history.evaluations()
     out_dir = workdir / "summary"
     out_dir.mkdir(exist_ok=True)
@@ -245,18 +286,66 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
             vals = [e.metrics[key] for e in evs if key in e.metrics and not math.isnan(e.metrics[key])]
             if vals and key not in metrics:
                 metrics[f"best_{key}"] = float(max(vals))
+    # search=single logged its evaluation on this run: a summary value of the same name is not logged twice
+    logged = set() if nested else set(store.get_run(run_id).data.metrics)
     with store.metrics(run_id) as buf:
-        buf.add_many(metrics)
-        for key, points in curves.items():  # run-level curves: [(step, value), ...]
-            for step, value in points:
-                buf.add(key, float(value), int(step))
+        buf.add_many({k: v for k, v in metrics.items() if k not in logged})
+        for key, points in curves.items():  # run-level curves: [(step, value[, unix_s]), ...]
+            for step, value, when in _points(points):
+                buf.add(key, value, step, when)
     if not nested:  # the evaluations were logged on this run: report their metrics as the run's
         for e in evs:
             metrics = {**{k: float(v) for k, v in e.metrics.items()}, **metrics}
+    table = _summary_table(task, evs, out_dir)
     h5.write(out_dir / "search.h5", {"history": history.arrays(), "searcher": searcher.summary() or {}},
              attrs={"format": "jt.search/1"})
     history.save(hist_path)
     store.log_artifacts(run_id, out_dir)
     store.log_artifact(run_id, hist_path)
-    return metrics
+    pictures = _summary_artifacts(store, run_id, task, evs, workdir / "pictures")
+    pictures += [str(p.relative_to(out_dir)) for p in sorted(out_dir.rglob("*"))
+                 if p.suffix.lower() in describe.PICTURES]
+    return metrics, pictures, table
 
+
+def _summary_artifacts(store: Store, run_id: str, task: Any, evs: list[Evaluation], folder: Path) -> list[str]:
+    """Call the task's ``summary_artifacts`` hook and log what it returns on the outer run (files in
+    ``folder`` keep their sub-folder); the artifact names. A path that is no file is skipped, said."""
+    hook = getattr(task, "summary_artifacts", None)
+    if hook is None:
+        return []
+    folder.mkdir(parents=True, exist_ok=True)
+    names = []
+    for p in hook(evs, folder) or []:
+        p = Path(p)
+        if not p.is_file():
+            _log(f"jt: warning: {type(task).__name__}.summary_artifacts returned {p}, which is not a file; not logged")
+            continue
+        try:
+            sub = p.resolve().parent.relative_to(folder.resolve())
+        except ValueError:
+            sub = Path(".")
+        store.log_artifact(run_id, p, None if str(sub) == "." else str(sub))
+        names.append(str(sub / p.name) if str(sub) != "." else p.name)
+    return names
+
+
+def _summary_table(task: Any, evs: list[Evaluation], out_dir: Path) -> Optional[tuple[list, list]]:
+    """The task's ``summary_table`` (``(header, rows)`` or None), written to ``summary_table.json``."""
+    import json
+
+    hook = getattr(task, "summary_table", None)
+    got = hook(evs) if hook is not None else None
+    if not got:
+        return None
+    header, rows = got
+    header = [str(h) for h in header]
+    rows = [[v if isinstance(v, (int, float, str, bool)) or v is None else str(v) for v in row] for row in rows]
+    bad = [i for i, row in enumerate(rows) if len(row) != len(header)]
+    if bad:  # a plugin's slip must not fail a finished search: say it, show no table
+        _log(f"jt: warning: {type(task).__name__}.summary_table: row {bad[0]} has {len(rows[bad[0]])} cells "
+             f"for {len(header)} columns; no summary table")
+        return None
+    (out_dir / "summary_table.json").write_text(json.dumps({"header": header, "rows": rows}, indent=1,
+                                                           allow_nan=True))
+    return header, rows

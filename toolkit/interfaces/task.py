@@ -46,7 +46,11 @@ class Evaluation:
         failed: True when the evaluation failed as the task defines failure (a fall, NaN state);
             a failure is a result, not an error.
         reason: why it failed.
-        history: metric curves ``{name: [(step, value), ...]}``, logged with ``log_batch``.
+        history: metric curves ``{name: [(step, value), ...]}`` or with the time each point was
+            measured, ``[(step, value, unix_seconds), ...]`` (MLflow's wall-time axis; without it every
+            point carries the time the runner logged it). Logged as ``train/<name>`` (the task's
+            ``curve_prefix``; a name with a ``/`` is kept as it is), so a curve never shares its key
+            with the final value in ``metrics``; ``step`` is the curve's x (samples, for training).
         artifacts: names of files in the workdir to log (default: every file there).
         point: the parameters evaluated (filled in by the runner).
     """
@@ -56,7 +60,7 @@ class Evaluation:
     objectives: Sequence[float] = ()
     failed: bool = False
     reason: str = ""
-    history: dict[str, list[tuple[int, float]]] = dataclasses.field(default_factory=dict)
+    history: dict[str, list[tuple]] = dataclasses.field(default_factory=dict)
     artifacts: Optional[list[str]] = None
     point: dict[str, float] = dataclasses.field(default_factory=dict)
 
@@ -72,6 +76,8 @@ class Task(Plugin, abc.ABC):
         key_metrics: the metrics ``jt compare`` tabulates (mean ± std over seeds).
         timing_metrics: metrics that measure wall time (frames per second, time shares): they
             differ between runs by nature and are left out of same-seed checks.
+        curve_prefix: where an evaluation's ``history`` curves go in MLflow (``train/``: the chart
+            section "train", ``train/mean_return`` beside the final ``mean_return``).
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
@@ -79,6 +85,7 @@ class Task(Plugin, abc.ABC):
 
     key_metrics: ClassVar[tuple[str, ...]] = ()
     timing_metrics: ClassVar[tuple[str, ...]] = ()
+    curve_prefix: ClassVar[str] = "train/"
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg
@@ -108,3 +115,29 @@ class Task(Plugin, abc.ABC):
         history (e.g. the hypervolume after each simulation).
         """
         return {}
+
+    def summary_artifacts(self, evaluations: Sequence[Evaluation], folder: Path) -> list[Path]:
+        """Pictures (or other files) that summarise a whole search, for its outer run.
+
+        The runner calls this once at the end of a run, after ``summarize``, and logs every file
+        returned on the outer run (a file under ``folder`` keeps its sub-folder), so the run a
+        researcher opens first carries the gallery, not only its child runs. Default: none.
+
+        Args:
+            evaluations: every evaluation of the run, in order (``point``, ``metrics``, ``features``,
+                ``objectives``; their files are in the run's ``work/<run>/eval_NNNN/`` folders).
+            folder: an empty folder to write into.
+
+        Returns:
+            The files to log (paths that are no file are skipped with a warning).
+        """
+        return []
+
+    def summary_table(self, evaluations: Sequence[Evaluation]) -> Optional[tuple[list[str], list[list]]]:
+        """A table that summarises the run, ``(header, rows)``, or None (the default: no table).
+
+        Cells are numbers or text. The runner writes it to the outer run's ``summary_table.json``
+        and its description (a markdown table on the run's Overview page); ``jt show RUN_ID``
+        prints it.
+        """
+        return None

@@ -33,7 +33,7 @@ def test_search_runs_evaluations_as_nested_runs(example_plugin, store_dir):
         data = h5.read(art / "evaluation.h5")
         assert np.isclose(data["value"], c.data.metrics["value"])
         assert {"feature_0", "objective_value", "eval_seconds"} <= set(c.data.metrics)
-        assert len(store.client.get_metric_history(c.info.run_id, "curve")) == 5
+        assert len(store.client.get_metric_history(c.info.run_id, "train/curve")) == 5
     hist = h5.read(store.artifact_dir(res.run_id) / "search_history.h5")
     assert hist["x"].shape == (4, 2) and list(hist["batch"]) == [0, 0, 1, 1]
     assert outer.data.metrics["n_evaluations"] == 4
@@ -156,3 +156,75 @@ def test_long_evaluations_show_progress_even_in_parallel_workers(example_plugin_
         assert f"eval {i}: 100.0% bowl" in slow.stderr
     fast = run_jt(*common, "task.sleep=0", extra_path=example_plugin_dir)
     assert fast.returncode == 0 and "% bowl" not in fast.stderr
+
+
+def test_runs_read_well_in_the_ui(example_plugin, store_dir):
+    """What a researcher meets in ``jt ui``: finals and curves under distinct keys, each logged once,
+    curve points with their own times, descriptions, MLflow's user/commit tags, an experiment
+    description, the outer run's summary picture and table, HDF5 previews, no store outside the store."""
+    cfg = compose(["task=quadratic", "task.sleep=0.05", "search=random", "search.budget=2", "search.batch=2",
+                   "executor.workers=1", f"store={store_dir}", "seed=4"])
+    res = run(cfg)
+    store = res.store
+    outer = store.get_run(res.run_id)
+    child = store.client.search_runs([outer.info.experiment_id],
+                                     filter_string=f"tags.mlflow.parentRunId = '{res.run_id}'",
+                                     order_by=["attributes.run_name"])[0]
+    cid = child.info.run_id
+    assert child.info.run_name == "eval-0000"
+    final = store.client.get_metric_history(cid, "value")
+    assert [m.step for m in final] == [0]  # the final value once, at step 0
+    curve = sorted(store.client.get_metric_history(cid, "train/curve"), key=lambda m: m.step)
+    assert [m.step for m in curve] == [0, 1, 2, 3, 4]
+    assert store.client.get_metric_history(cid, "curve") == []  # no bare key mixing curve and final
+    times = [m.timestamp for m in curve]
+    assert times == sorted(times) and len(set(times)) == 5  # each point its own time (~10 ms apart)
+    assert times[-1] - times[0] >= 30
+    for key in child.data.metrics:  # nothing logged twice at one step
+        steps = [m.step for m in store.client.get_metric_history(cid, key)]
+        assert len(steps) == len(set(steps)), key
+    note = child.data.tags["mlflow.note.content"]
+    assert note.startswith("**Evaluation 0** of `quadratic·random·seed4` at `x0=")
+    assert "| value |" in note and "`evaluation.h5`" not in note  # pictures only, none here
+    tags = outer.data.tags
+    assert tags["mlflow.user"] and tags["mlflow.source.git.commit"] == tags["jt.git_commit"].split("+")[0]
+    desc = tags["mlflow.note.content"]
+    assert "Reproduce: `jt " in desc and "| n_evaluations | 2 |" in desc and "`points.png`" in desc
+    assert "| eval | x0 | x1 | value |" in desc  # the task's summary_table, as markdown
+    art = store.artifact_dir(res.run_id)
+    assert (art / "points.png").stat().st_size > 1000  # the task's summary_artifacts, on the outer run
+    import json
+
+    table = json.loads((art / "summary_table.json").read_text())
+    assert table["header"] == ["eval", "x0", "x1", "value"] and len(table["rows"]) == 2
+    preview = (art / "search_history.h5.txt").read_text()  # a preview beside every .h5
+    assert "@format = jt.search_history/1" in preview and "\nx  2×2 float64" in preview
+    assert "\nhistory/\n" in (art / "search.h5.txt").read_text()
+    assert "x  2 float64" in (store.artifact_dir(cid) / "evaluation.h5.txt").read_text()
+    exp = store.client.get_experiment(outer.info.experiment_id)
+    assert "quadratic" in exp.tags["mlflow.note.content"] and exp.tags["jt.task"] == "quadratic"
+    default = store.client.get_experiment("0")
+    assert default.artifact_location.startswith(str(store.root))
+
+
+def test_a_bad_summary_hook_is_a_warning_not_a_lost_run(tmp_path):
+    """A summary_artifacts path that is no file is skipped (and said); a ragged table is dropped."""
+    from toolkit.execution import runner
+    from toolkit.interfaces import Evaluation
+    from toolkit.store.tracking import Store
+
+    class Sloppy:
+        def summary_artifacts(self, evaluations, folder):
+            (folder / "ok.png").write_bytes(b"png")
+            return [folder / "ok.png", folder / "missing.png"]
+
+        def summary_table(self, evaluations):
+            return ["a", "b"], [[1, 2], [3]]
+
+    store = Store(tmp_path / "s")
+    rid = store.start_run("e")
+    evs = [Evaluation(metrics={"v": 1.0})]
+    assert runner._summary_artifacts(store, rid, Sloppy(), evs, tmp_path / "pics") == ["ok.png"]
+    assert (store.artifact_dir(rid) / "ok.png").is_file()
+    assert runner._summary_table(Sloppy(), evs, tmp_path) is None
+    assert not (tmp_path / "summary_table.json").exists()

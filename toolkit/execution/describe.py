@@ -1,0 +1,116 @@
+"""What a run says about itself in the MLflow UI: markdown descriptions and provenance tags.
+
+MLflow shows a run's ``mlflow.note.content`` tag as the description on its Overview page (markdown),
+an experiment's as the experiment's description, and ``mlflow.user`` / ``mlflow.source.git.commit``
+as "Created by" and the source version. Every run jt makes gets them: outer runs (what ran, the
+command that reproduces it, the headline metrics, where the pictures are), evaluations (their point
+and seed, their metrics, their pictures) and comparisons (the table).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Iterable, Mapping, Optional, Sequence
+
+NOTE = "mlflow.note.content"
+PICTURES = (".png", ".gif", ".mp4", ".jpg", ".svg")
+
+
+def provenance_tags(command: str) -> dict[str, str]:
+    """MLflow's own source tags and jt's: user, git commit (without ``+dirty``), command, version."""
+    from toolkit.execution import provenance
+    from toolkit.store.tracking import user
+
+    commit = provenance.git_commit()
+    tags = {"mlflow.user": user(), "mlflow.source.name": "jt", "mlflow.source.type": "LOCAL",
+            "jt.version": provenance.jt_version(), "jt.git_commit": commit, "jt.command": command}
+    if commit != "unknown":
+        tags["mlflow.source.git.commit"] = commit.split("+", 1)[0]
+    return tags
+
+
+def fmt(value: Any) -> str:
+    """A number as a table shows it (4 significant digits), anything else as text."""
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, (int, float)):
+        return "nan" if math.isnan(float(value)) else f"{float(value):.4g}"
+    return str(value)
+
+
+def table(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
+    """A markdown table (``|`` in cells escaped)."""
+    def cell(v: Any) -> str:
+        return fmt(v).replace("|", "\\|").replace("\n", " ")
+
+    lines = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def headline(metrics: Mapping[str, float], keys: Sequence[str], limit: int = 8) -> list[tuple[str, float]]:
+    """The metrics worth a first look: ``keys`` (and their ``best_``), then the others, at most ``limit``."""
+    first = [k for key in keys for k in (key, f"best_{key}") if k in metrics]
+    rest = [k for k in metrics if k not in first]
+    return [(k, metrics[k]) for k in (first + rest)[:limit]]
+
+
+def _pictures(names: Iterable[str]) -> list[str]:
+    return sorted({n for n in names if n.lower().endswith(PICTURES)})
+
+
+def outer(cfg: Any, command: str, metrics: Optional[Mapping[str, float]] = None, keys: Sequence[str] = (),
+          pictures: Iterable[str] = (), nested: bool = True, summary: str = "") -> str:
+    """The outer run's description: what ran, how to rerun it, headline metrics, where pictures are.
+
+    Args:
+        cfg: the run's composed config.
+        command: the command that reproduces it.
+        metrics: the run's final metrics (None while it runs).
+        keys: the task's key metrics (shown first).
+        pictures: artifact names of the run's own pictures.
+        nested: whether evaluations are child runs.
+        summary: extra markdown (e.g. the task's summary table).
+    """
+    t, s = cfg.task.name, cfg.search.name
+    budget = cfg.search.get("budget", None)
+    lines = [f"**{t} · {s} · seed {cfg.seed}**: task `{t}` searched by `{s}`"
+             + (f" (budget {budget} evaluations)" if budget is not None and nested else "") + ".",
+             "", f"Reproduce: `{command}`", ""]
+    if metrics is None:
+        lines.append("Running; the headline metrics appear here when it finishes.")
+    else:
+        lines += [table(["metric", "value"], headline(metrics, keys)), ""]
+    pics = _pictures(pictures)
+    where = []
+    if pics:
+        where.append("this run's artifacts: " + ", ".join(f"`{p}`" for p in pics))
+    if nested:
+        where.append("each evaluation's own pictures are in its child run `eval-NNNN` (expand this run in the list)")
+    if where:
+        lines += ["", "Pictures: " + "; ".join(where) + "."]
+    if summary:
+        lines += ["", summary]
+    return "\n".join(lines).strip() + "\n"
+
+
+def evaluation(index: int, parent: str, point: Mapping[str, float], seed: int, metrics: Mapping[str, float],
+               keys: Sequence[str], artifacts: Iterable[str], failed: str = "") -> str:
+    """An evaluation's description: its point (the take-off point, for a jump), seed, metrics, pictures."""
+    where = ", ".join(f"`{k}={v:.4g}`" for k, v in point.items()) or "the task's defaults (no search parameters)"
+    lines = [f"**Evaluation {index}** of `{parent}` at {where}, seed {seed}."]
+    if failed:
+        lines.append(f"Failed: {failed}.")
+    lines += ["", table(["metric", "value"], headline(metrics, keys))]
+    pics = _pictures(artifacts)
+    if pics:
+        lines += ["", "Pictures (artifacts): " + ", ".join(f"`{p}`" for p in pics) + "."]
+    return "\n".join(lines) + "\n"
+
+
+def experiment(task: str, summary: str) -> str:
+    """An experiment's description (one experiment per task)."""
+    return (f"Runs of the jt task `{task}`" + (f": {summary}" if summary else ".") + "\n\n"
+            f"Outer runs are named `{task}·<search>·seed<N>`; a searcher's evaluations are their child "
+            "runs `eval-NNNN`; a `jt compare` is a run `compare ...` whose children are the compared runs "
+            "(`<variant>·seed=<N>`). Each run's description says what it is and how to rerun it.\n")
