@@ -17,6 +17,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from toolkit.errors import JtError
+from toolkit.execution import describe, provenance
 
 
 @dataclasses.dataclass
@@ -50,10 +51,28 @@ def _cell(args: tuple[list[str], bool]) -> tuple[str, dict[str, float]]:
     from toolkit.config import compose
     from toolkit.execution.runner import run
 
+    command = "jt run " + " ".join(overrides)  # what reruns this cell alone
     if inner_serial:
         overrides = [*overrides, "executor.workers=1"]
-    res = run(compose(overrides))
+    res = run(compose(overrides), command=command)
     return res.run_id, res.metrics
+
+
+def metric_label(variant: str) -> str:
+    """A variant as the first part of an MLflow metric key: ``search=bds`` → ``bds``, several keys
+    ``a=1, b=x`` → ``1_x`` (MLflow keys allow letters, digits and ``_-. /:``)."""
+    import re
+
+    values = [part.split("=", 1)[-1] for part in variant.split(", ")]
+    return re.sub(r"[^\w.\- :]", "_", "_".join(values)).strip() or "all"
+
+
+def _params(overrides: Sequence[str], grid: list[tuple[str, list[str]]], seeds: int) -> dict[str, str]:
+    """The comparison's params: each base override ``base.<key>``, each ``vary.<key>``, ``seeds``."""
+    out = {f"base.{o.split('=', 1)[0]}": (o.split("=", 1)[1] if "=" in o else "") for o in overrides}
+    out.update({f"vary.{k}": ",".join(v) for k, v in grid})
+    out["seeds"] = str(seeds)
+    return out
 
 
 def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> CompareResult:
@@ -89,8 +108,12 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     task_cls = plugins.load("task", str(base.task.name))
     label = ", ".join(f"{k}={','.join(v)}" for k, v in grid)
     experiment = str(base.task.name)
-    run_id = store.start_run(experiment, run_name=f"compare {label} x{seeds}",
-                             tags={"jt.compare": "true", "jt.vary": label, "jt.seeds": str(seeds)})
+    command = provenance.command_line() if provenance.command_line().startswith("jt compare") else \
+        " ".join(["jt compare", *overrides, *(f"--vary {v}" for v in vary), f"--seeds {seeds}"])
+    run_id = store.start_run(experiment, run_name=store.unique_run_name(experiment, f"compare {label} x{seeds}"),
+                             tags={**describe.provenance_tags(command), "jt.compare": "true", "jt.vary": label,
+                                   "jt.seeds": str(seeds), describe.NOTE: f"Comparison running: `{command}`\n"})
+    store.log_params(run_id, _params(overrides, grid, seeds))
     try:
         executor = plugins.load("executor", str(base.executor.name))(base.executor)
         parallel = executor.n_workers > 1 and len(cells) > 1
@@ -107,7 +130,7 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
             executor.close()
         per_cell = [(", ".join(f"{k}={v}" for k, v in zip(keys, values)), rid, m)
                     for (values, _, _), (rid, m) in zip(cells, results)]
-        out = _record(store, run_id, per_cell, list(getattr(task_cls, "key_metrics", ())), label)
+        out = _record(store, run_id, per_cell, list(getattr(task_cls, "key_metrics", ())), label, command)
         store.end_run(run_id, "FINISHED")
         return out
     except KeyboardInterrupt:
@@ -146,14 +169,17 @@ def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareRes
     if task_name in plugins.names("task"):
         keys = list(getattr(plugins.load("task", task_name), "key_metrics", ()))
     exp = store.client.get_experiment(runs[0].info.experiment_id).name
-    run_id = store.start_run(exp, run_name=f"compare {len(runs)} runs", tags={"jt.compare": "true"})
-    out = _record(store, run_id, per_cell, keys, ", ".join(differing) or "runs")
+    command = " ".join(["jt compare --runs", *run_ids, *overrides])
+    run_id = store.start_run(exp, run_name=store.unique_run_name(exp, f"compare {len(runs)} runs"),
+                             tags={**describe.provenance_tags(command), "jt.compare": "true"})
+    store.log_params(run_id, {"runs": ",".join(run_ids), "differing": ",".join(differing) or "none"})
+    out = _record(store, run_id, per_cell, keys, ", ".join(differing) or "runs", command)
     store.end_run(run_id, "FINISHED")
     return out
 
 
 def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, float]]],
-            keys: list[str], label: str) -> CompareResult:
+            keys: list[str], label: str, command: str) -> CompareResult:
     from toolkit.store import h5
 
     if not keys:  # every metric all runs share
@@ -183,11 +209,27 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
     _plot(rows, keys, wd / "compare.png", label)
     store.log_artifacts(run_id, wd)
     store.set_tags(run_id, {"jt.compare.runs": ",".join(rid for _, rid, _ in per_cell)[:5000]})
+    labels: dict[str, str] = {}
+    for r in rows:  # one metric per variant and statistic: <variant>/<metric>_mean, _std
+        lab = metric_label(r["variant"])
+        labels[r["variant"]] = lab if lab not in labels.values() else f"{lab}_{len(labels)}"
     with store.metrics(run_id) as buf:
-        for i, r in enumerate(rows):
+        for r in rows:
             for k in keys:
                 if not math.isnan(r[k][0]):
-                    buf.add(f"{k}_mean", r[k][0], step=i)
+                    buf.add(f"{labels[r['variant']]}/{k}_mean", r[k][0])
+                    buf.add(f"{labels[r['variant']]}/{k}_std", r[k][1])
+            buf.add(f"{labels[r['variant']]}/n", float(r["n"]))
+    names = {rid: store.get_run(rid).info.run_name for _, rid, _ in per_cell}
+    note = "\n".join([
+        f"**Comparison** of {label} ({len(per_cell)} runs): mean ± std over seeds.", "",
+        f"Reproduce: `{command}`", "",
+        describe.table(["variant", "n", *keys, "runs"],
+                       [[r["variant"], r["n"], *(f"{r[k][0]:.4g} ± {r[k][1]:.2g}" for k in keys),
+                         ", ".join(names.get(x) or x for x in r["runs"])] for r in rows]), "",
+        "Metrics: `<variant>/<metric>_mean` and `_std`; the bar chart is the artifact `compare.png`, "
+        "the numbers `compare.h5`; the compared runs are this run's children."])
+    store.set_tags(run_id, {describe.NOTE: note + "\n"})
     return CompareResult(table, run_id, store.root, rows)
 
 

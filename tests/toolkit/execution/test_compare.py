@@ -77,3 +77,26 @@ def test_runs_are_named_for_what_they_are_and_never_collide(example_plugin, stor
     kids = store.get_run(res.run_id).data.tags["jt.compare.runs"].split(",")
     names = [store.get_run(k).data.tags["mlflow.runName"] for k in kids]
     assert names == ["task.centre=0.0·seed=0", "task.centre=0.5·seed=0"]
+
+
+def test_the_comparison_run_reads_well(example_plugin, store_dir):
+    """Params (base overrides, varied keys, seeds), MLflow's commit and user tags, one metric per
+    variant and statistic, the table as its markdown description; children rerun on their own."""
+    from toolkit.store.tracking import Store
+
+    res = compare(["task=quadratic", "executor.workers=1", f"store={store_dir}"], ["task.centre=0.0,0.5"], seeds=2)
+    run = Store(store_dir).get_run(res.run_id)
+    p, m, tags = run.data.params, run.data.metrics, run.data.tags
+    assert p["base.task"] == "quadratic" and p["vary.task.centre"] == "0.0,0.5" and p["seeds"] == "2"
+    assert tags["mlflow.source.git.commit"] and tags["mlflow.user"] and tags["jt.command"].startswith("jt compare")
+    assert m["0.5/value_mean"] == 0.5 and m["0.5/value_std"] == 0.0 and m["0.0/value_mean"] == 0.0
+    assert m["0.5/n"] == 2
+    store = Store(store_dir)
+    assert [h.step for h in store.client.get_metric_history(res.run_id, "0.5/value_mean")] == [0]
+    assert "value_mean" not in m  # no single key over steps mixing the variants
+    note = tags["mlflow.note.content"]
+    assert "| variant | n | value | runs |" in note and "| task.centre=0.5 | 2 | 0.5 ± 0 |" in note
+    assert "task.centre=0.5·seed=1" in note  # the children by name
+    kid = store.get_run(tags["jt.compare.runs"].split(",")[-1])
+    assert kid.data.tags["jt.command"] == f"jt run task=quadratic executor.workers=1 store={store_dir} " \
+                                         "task.centre=0.5 seed=1"
