@@ -120,11 +120,14 @@ def compare_cmd(
 def show_cmd(
     run_id: str = typer.Argument(..., help="Run id."),
     overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH or store=http://host:port"),
+    artifact: Optional[str] = typer.Option(None, "--artifact", help="Print one artifact: an .h5 as its "
+                                           "preview (groups, datasets, shapes, attributes), text as it is."),
 ) -> None:
-    """Print a run's config, final metrics and artifacts (a server store's are downloaded)."""
+    """Print a run's description, config, metrics, summary table and artifacts (a server store's are
+    downloaded), or one artifact with --artifact NAME."""
     from toolkit.execution.show import show
 
-    typer.echo(show(run_id, _store_arg(overrides)))
+    typer.echo(show(run_id, _store_arg(overrides), artifact))
 
 
 @app.command("ui", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
@@ -134,6 +137,7 @@ def ui_cmd(
     open_browser: bool = typer.Option(False, "--open", help="Open a server store's URL in a browser."),
 ) -> None:
     """Serve the MLflow UI for the store on 127.0.0.1 (a server store: print its URL)."""
+    import os
     import subprocess
 
     from toolkit.store.tracking import Store, is_server_uri, store_root
@@ -149,9 +153,12 @@ def ui_cmd(
     store = Store(root)
     typer.echo(f"MLflow UI for {store.root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
     cmd = [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", store.uri,
-           "--host", "127.0.0.1", "--port", str(port)]
+           "--default-artifact-root", str(store.root / "runs"), "--host", "127.0.0.1", "--port", str(port),
+           "--workers", "1"]
+    # one worker and no job runners (MLflow's GenAI jobs): up in seconds on a small machine
+    env = {**os.environ, "MLFLOW_SERVER_ENABLE_JOB_EXECUTION": "false"}
     try:
-        subprocess.run(cmd, check=False)
+        subprocess.run(cmd, check=False, env=env)
     except KeyboardInterrupt:
         pass
 
