@@ -137,10 +137,7 @@ def ui_cmd(
     open_browser: bool = typer.Option(False, "--open", help="Open a server store's URL in a browser."),
 ) -> None:
     """Serve the MLflow UI for the store on 127.0.0.1 (a server store: print its URL)."""
-    import os
-    import subprocess
-
-    from toolkit.store.tracking import Store, is_server_uri, store_root
+    from toolkit.store.tracking import is_server_uri, store_root
 
     root = store_root(_store_arg(overrides))
     if is_server_uri(root):  # the tracking server serves its own UI: nothing to start here
@@ -150,17 +147,10 @@ def ui_cmd(
 
             webbrowser.open(str(root))
         return
-    store = Store(root)
-    typer.echo(f"MLflow UI for {store.root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
-    cmd = [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", store.uri,
-           "--default-artifact-root", str(store.root / "runs"), "--host", "127.0.0.1", "--port", str(port),
-           "--workers", "1"]
-    # one worker and no job runners (MLflow's GenAI jobs): up in seconds on a small machine
-    env = {**os.environ, "MLFLOW_SERVER_ENABLE_JOB_EXECUTION": "false"}
-    try:
-        subprocess.run(cmd, check=False, env=env)
-    except KeyboardInterrupt:
-        pass
+    from toolkit.store.ui import serve
+
+    typer.echo(f"MLflow UI for {root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
+    serve(root, port)
 
 
 @app.command("plugins")

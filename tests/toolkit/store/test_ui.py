@@ -1,0 +1,62 @@
+"""jt ui: MLflow's UI with one worker and no job runners; SIGTERM stops it with the server."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+
+from tests.conftest import jt_env
+from tests.plugins.jt_executors.ray_cluster import free_port
+from toolkit.store.tracking import Store
+from toolkit.store.ui import command
+
+
+def _children(pid):
+    out = subprocess.run(["ps", "-eo", "pid=,ppid=,args="], capture_output=True, text=True).stdout
+    rows = [ln.split(None, 2) for ln in out.splitlines() if ln.strip()]
+    kids, todo = [], [str(pid)]
+    while todo:
+        p = todo.pop()
+        for r in rows:
+            if r[1] == p:
+                kids.append(r)
+                todo.append(r[0])
+    return kids
+
+
+def test_command_is_one_worker_without_jobs(tmp_path):
+    cmd, env = command(tmp_path, 5001)
+    assert cmd[cmd.index("--workers") + 1] == "1" and env["MLFLOW_SERVER_ENABLE_JOB_EXECUTION"] == "false"
+    assert cmd[cmd.index("--default-artifact-root") + 1] == str(tmp_path / "runs")
+
+
+def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
+    store = Store(tmp_path / "s")
+    store.end_run(store.start_run("exp", run_name="r"))
+    port = free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "ui", f"store={tmp_path / 's'}", "--port", str(port)],
+                            env=jt_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline, up = time.monotonic() + 120, False
+        while time.monotonic() < deadline and not up and proc.poll() is None:
+            try:
+                up = urllib.request.urlopen(f"http://127.0.0.1:{port}/health", timeout=2).status == 200
+            except OSError:
+                time.sleep(0.3)
+        assert up, proc.stderr.read() if proc.poll() is not None else "not up in 120 s"
+        kids = _children(proc.pid)
+        assert sum("uvicorn" in k[2] for k in kids) == 1, kids  # one server process, no extra workers
+        assert not any("huey" in k[2] for k in kids), kids  # no job runners
+        body = urllib.request.urlopen(f"http://127.0.0.1:{port}/ajax-api/2.0/mlflow/experiments/search?max_results=10",
+                                      timeout=10).read().decode()
+        assert '"exp"' in body
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=30)
+        time.sleep(1)
+        assert not [k for k in kids if os.path.exists(f"/proc/{k[0]}")], "the server outlived jt ui"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
