@@ -75,14 +75,36 @@ def save_png(image: np.ndarray, path: str | Path) -> Path:
     return path
 
 
-def save_animation(frames: Sequence[np.ndarray], path: str | Path, fps: float = 30.0) -> Path:
-    """Write frames as an animated GIF (``.gif``) or MP4 (``.mp4``, needs imageio-ffmpeg)."""
+MIN_ANIMATION_WIDTH = 320
+"""px: an animation narrower than this is enlarged (whole pixels) to at least this wide."""
+SMOKE_WIDTH = 96
+"""px: frames narrower than this (smoke presets render 64) are kept as they are: a smoke run checks
+the pipeline, and a GIF five times its frames' size costs seconds to encode."""
+
+
+def enlarge(frames: Sequence[np.ndarray], min_width: int = MIN_ANIMATION_WIDTH) -> list[np.ndarray]:
+    """Frames ``(h, w, 3)`` scaled up by the smallest whole factor that makes them at least
+    ``min_width`` wide (each pixel repeated: nothing blurred, nothing invented); frames already as
+    wide, or narrower than ``SMOKE_WIDTH``, as they are."""
+    frames = [np.asarray(f)[..., :3].astype(np.uint8) for f in frames]
+    if not frames:
+        return frames
+    w = frames[0].shape[1]
+    k = -(-int(min_width) // w) if SMOKE_WIDTH <= w < min_width else 1
+    return frames if k == 1 else [np.repeat(np.repeat(f, k, axis=0), k, axis=1) for f in frames]
+
+
+def save_animation(frames: Sequence[np.ndarray], path: str | Path, fps: float = 30.0,
+                   min_width: int = MIN_ANIMATION_WIDTH) -> Path:
+    """Write frames ``(h, w, 3)`` as an animated GIF (``.gif``) or MP4 (``.mp4``, needs
+    imageio-ffmpeg), at least ``min_width`` px wide (``enlarge``; 0: as rendered)."""
     import imageio.v3 as iio
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    frames = enlarge(frames, min_width) if min_width else [np.asarray(f)[..., :3] for f in frames]
     if path.suffix == ".gif":
-        iio.imwrite(path, np.stack(frames), duration=1000.0 / fps, loop=0)
+        iio.imwrite(path, np.stack(frames), duration=1000.0 / max(float(fps), 1e-3), loop=0)
     else:
         iio.imwrite(path, np.stack(frames), fps=fps)
     return path

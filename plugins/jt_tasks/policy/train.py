@@ -163,16 +163,18 @@ def pick_frames(frames: list, n: int) -> list:
 
 def save_motion(workdir: Path, frames: list, n_filmstrip: int, fps: float = 30.0) -> list[str]:
     """``filmstrip.png`` (``n_filmstrip`` frames side by side) and ``motion.gif`` (all frames at
-    ``fps``) in ``workdir``; the names written."""
+    ``fps``, enlarged to at least 320 px wide unless smoke-sized: ``toolkit.render.enlarge``) in
+    ``workdir``; the names written."""
     import imageio.v3 as iio
+
+    from toolkit.render import save_animation
 
     if not frames:
         return []
     strip = pick_frames(frames, n_filmstrip)
     iio.imwrite(Path(workdir) / "filmstrip.png",
                 np.concatenate([np.asarray(f)[..., :3] for f in strip], axis=1).astype(np.uint8))
-    iio.imwrite(Path(workdir) / "motion.gif", np.stack([np.asarray(f)[..., :3] for f in frames]).astype(np.uint8),
-                duration=1000.0 / max(float(fps), 1e-3), loop=0)
+    save_animation(frames, Path(workdir) / "motion.gif", fps)
     return ["filmstrip.png", "motion.gif"]
 
 
