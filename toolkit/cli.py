@@ -147,9 +147,9 @@ def ui_cmd(
 
             webbrowser.open(str(root))
         return
-    from toolkit.store.ui import serve
+    from toolkit.store.ui import serve, url
 
-    typer.echo(f"MLflow UI for {root}: http://127.0.0.1:{port}  (Ctrl-C to stop)")
+    typer.echo(f"MLflow UI for {root}: {url(port)}  (Ctrl-C to stop)")
     serve(root, port)
 
 

@@ -108,6 +108,7 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     task_cls = plugins.load("task", str(base.task.name))
     label = ", ".join(f"{k}={','.join(v)}" for k, v in grid)
     experiment = str(base.task.name)
+    describe.ensure_experiment(store, experiment, task_cls)
     command = provenance.command_line() if provenance.command_line().startswith("jt compare") else \
         " ".join(["jt compare", *overrides, *(f"--vary {v}" for v in vary), f"--seeds {seeds}"])
     run_id = store.start_run(experiment, run_name=store.unique_run_name(experiment, f"compare {label} x{seeds}"),

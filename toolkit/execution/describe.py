@@ -74,13 +74,13 @@ def outer(cfg: Any, command: str, metrics: Optional[Mapping[str, float]] = None,
     """
     t, s = cfg.task.name, cfg.search.name
     budget = cfg.search.get("budget", None)
-    lines = [f"**{t} · {s} · seed {cfg.seed}**: task `{t}` searched by `{s}`"
-             + (f" (budget {budget} evaluations)" if budget is not None and nested else "") + ".",
-             "", f"Reproduce: `{command}`", ""]
+    what = (f"task `{t}` searched by `{s}`" + (f" (budget {budget} evaluations)" if budget is not None else "")
+            if nested else f"one evaluation of task `{t}`, in this run (search `{s}`)")
+    lines = [f"**{t} · {s} · seed {cfg.seed}**: {what}.", "", f"Reproduce: `{command}`", ""]
     if metrics is None:
         lines.append("Running; the headline metrics appear here when it finishes.")
     else:
-        lines += [table(["metric", "value"], headline(metrics, keys)), ""]
+        lines.append(table(["metric", "value"], headline(metrics, keys)))
     pics = _pictures(pictures)
     where = []
     if pics:
@@ -106,6 +106,17 @@ def evaluation(index: int, parent: str, point: Mapping[str, float], seed: int, m
     if pics:
         lines += ["", "Pictures (artifacts): " + ", ".join(f"`{p}`" for p in pics) + "."]
     return "\n".join(lines) + "\n"
+
+
+def ensure_experiment(store: Any, task: str, task_cls: Any) -> str:
+    """Experiment ``task`` (created if missing) with its description and tags; its id.
+
+    ``mlflow.experimentKind = custom_model_development`` makes the UI open it in its "Model
+    training" view (not GenAI's traces), as choosing that view there would.
+    """
+    summary = ((getattr(task_cls, "__doc__", None) or "").strip().splitlines() or [""])[0]
+    return store.describe_experiment(task, experiment(task, summary), {
+        "jt.task": task, "mlflow.experimentKind": "custom_model_development"})
 
 
 def experiment(task: str, summary: str) -> str:

@@ -92,9 +92,7 @@ def _open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: A
         store.client.update_run(run.info.run_id, status="RUNNING")
         store.set_tags(run.info.run_id, {"jt.resumed": "true"})
         return run.info.run_id, True
-    summary = ((task_cls.__doc__ or "").strip().splitlines() or [""])[0]
-    store.describe_experiment(experiment, describe.experiment(experiment, summary),
-                              {"jt.task": experiment, "jt.kind": "task"})
+    describe.ensure_experiment(store, experiment, task_cls)
     tags = {
         **describe.provenance_tags(command),
         "jt.seed": str(cfg.seed),
@@ -161,11 +159,12 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
                 _log(f"jt: resumed after {len(history)} completed evaluation(s)")
             executor = exec_cls(cfg.executor)
             try:
-                _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
-                             names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
+                files = _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
+                                     names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
             finally:
                 executor.close()
             metrics, pictures, table = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
+            pictures += files  # search=single: the evaluation's own files are on this run
             note = describe.outer(cfg, command, metrics, getattr(task, "key_metrics", ()), pictures, nested,
                                   describe.table(*table) if table else "")
             store.set_tags(run_id, {describe.NOTE: note})
@@ -194,11 +193,14 @@ def _replay(searcher: Any, history: History, batch: int) -> None:
 
 def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experiment: str, task: Any,
                  searcher: Any, history: History, names: list[str], problem: Any, nested: bool,
-                 executor: Any, hist_path: Path, parent_name: str) -> None:
+                 executor: Any, hist_path: Path, parent_name: str) -> list[str]:
+    """Ask, evaluate, log and tell until the budget is spent; the files logged on the outer run
+    itself (by a searcher that is not ``nested``)."""
     budget = int(cfg.search.budget)
     obj_names = list(problem.objective_names)
     parent_name = parent_name or store.get_run(run_id).info.run_name
     prefix = str(getattr(task, "curve_prefix", "train/"))
+    on_outer: list[str] = []
     while not searcher.finished() and len(history) < budget:
         x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
         if len(x) == 0:  # a task with no parameters still has one (empty) point
@@ -221,6 +223,8 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
         for j, (ev, secs) in executor.imap(run_job, jobs):
             evs[j] = ev
             logged = _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs, prefix)
+            if not nested:
+                on_outer += logged
             history.add(Record(start + j, b, x[j], ev, child_ids[j] if nested else ""))
             if nested:
                 ctx = jobs[j].ctx
@@ -233,6 +237,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
                  f"{' FAILED: ' + ev.reason if ev.failed else ''} {shown}")
         history.save(hist_path)
         searcher.tell(x, evs)
+    return on_outer
 
 
 def curve_key(key: str, prefix: str = "train/") -> str:

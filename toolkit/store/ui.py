@@ -15,6 +15,11 @@ from pathlib import Path
 from typing import Any
 
 
+def url(port: int) -> str:
+    """Where the UI is, opening in its "Model training" view (MLflow 3 starts in GenAI's otherwise)."""
+    return f"http://127.0.0.1:{port}/#/experiments?workflowType=machine_learning"
+
+
 def command(root: Path, port: int) -> tuple[list[str], dict[str, str]]:
     """The ``mlflow ui`` command line and environment for the store at ``root``."""
     cmd = [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", f"sqlite:///{root / 'mlflow.db'}",

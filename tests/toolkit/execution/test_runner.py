@@ -203,6 +203,7 @@ def test_runs_read_well_in_the_ui(example_plugin, store_dir):
     assert "x  2 float64" in (store.artifact_dir(cid) / "evaluation.h5.txt").read_text()
     exp = store.client.get_experiment(outer.info.experiment_id)
     assert "quadratic" in exp.tags["mlflow.note.content"] and exp.tags["jt.task"] == "quadratic"
+    assert exp.tags["mlflow.experimentKind"] == "custom_model_development"  # the UI opens "Model training"
     default = store.client.get_experiment("0")
     assert default.artifact_location.startswith(str(store.root))
 
@@ -228,3 +229,14 @@ def test_a_bad_summary_hook_is_a_warning_not_a_lost_run(tmp_path):
     assert (store.artifact_dir(rid) / "ok.png").is_file()
     assert runner._summary_table(Sloppy(), evs, tmp_path) is None
     assert not (tmp_path / "summary_table.json").exists()
+
+
+def test_single_logs_each_metric_once_on_the_outer_run(example_plugin, store_dir):
+    """search=single evaluates in the outer run: the task's summary of the same name (spd_tracking
+    averages its one evaluation) is not logged a second time at step 0."""
+    res = run(compose(["task=quadratic", "executor.workers=1", f"store={store_dir}"]))
+    store = res.store
+    assert [m.step for m in store.client.get_metric_history(res.run_id, "value")] == [0]
+    assert len(store.client.get_metric_history(res.run_id, "train/curve")) == 5
+    note = store.get_run(res.run_id).data.tags["mlflow.note.content"]
+    assert "one evaluation of task `quadratic`, in this run" in note and "`points.png`" in note
