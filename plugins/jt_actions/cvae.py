@@ -32,8 +32,9 @@ class CVAEActionSpace(PVAEActionSpace):
     @dataclasses.dataclass
     class Config:
         name: str = "cvae"
-        prior: str = ""
-        """Prior.h5 path (or a folder with one) or the MLflow run id of a pose_prior run."""
+        prior: str = "auto"
+        """Prior.h5 path (or a folder with one), the MLflow run id of a pose_prior run, or "auto":
+        the store's own prior, trained on first use from the shipped clips (``toolkit.priors.auto``)."""
         store: str = ""
         """Store to look a run id up in: the run's own store by default."""
         latent_bound: float = 3.0

@@ -175,4 +175,7 @@ def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] =
     if not text:
         need = kind or "pvae"
         raise JtError(f"action={need} needs a pose prior (action.prior=RUN_ID or PATH); {how_to_make(need)}")
+    if text == "auto":
+        raise JtError("action.prior=auto is resolved by jt run before a run opens (toolkit.priors.auto); "
+                      f"outside jt run give a run id or a path; {how_to_make(kind or 'pvae')}")
     return read_prior(_find(text, store_root, kind or "pvae"), kind)

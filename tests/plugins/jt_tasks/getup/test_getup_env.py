@@ -104,4 +104,4 @@ def test_cvae_without_a_prior_is_one_line_error():
     from toolkit.config import compose, validate
 
     with pytest.raises(JtError, match="needs a trained prior"):
-        validate(compose(["task=getup"]))
+        validate(compose(["task=getup", "action.prior="]))

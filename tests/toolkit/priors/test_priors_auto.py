@@ -1,0 +1,49 @@
+"""action.prior=auto: the store's own prior, trained once and then reused (toolkit.priors.auto)."""
+
+from __future__ import annotations
+
+import pytest
+
+from toolkit.errors import JtError
+
+
+def _cfg(store, *extra):
+    from toolkit.config import compose
+
+    return compose(["task=highjump", "search=single", "experiment=smoke", "action=pvae", f"store={store}", *extra])
+
+
+def test_auto_trains_once_then_reuses(tmp_path):
+    from toolkit.priors import auto
+    from toolkit.priors.io import load_prior
+    from toolkit.store.tracking import Store
+
+    cfg = _cfg(tmp_path)
+    assert str(cfg.action.prior) == "auto" and auto.wants_auto(cfg) == "pvae"
+    first = auto.resolve(cfg, train_overrides=["experiment=smoke"])
+    run_id = str(first.action.prior)
+    assert run_id != "auto" and load_prior(run_id, str(tmp_path), kind="pvae").latent_dim > 0
+    store = Store(tmp_path)
+    assert store.get_run(run_id).data.tags[auto.TAG] == "pvae"
+    again = auto.resolve(_cfg(tmp_path), train_overrides=["experiment=smoke"])
+    assert str(again.action.prior) == run_id  # reused, not trained again
+    exp = store.client.get_experiment_by_name("pose_prior")
+    assert len(store.client.search_runs([exp.experiment_id])) == 1
+
+
+def test_explicit_priors_and_raw_actions_are_left_alone(tmp_path):
+    from toolkit.priors import auto
+
+    cfg = _cfg(tmp_path, "action=raw")
+    assert auto.wants_auto(cfg) == "" and auto.resolve(cfg) is cfg
+    cfg = _cfg(tmp_path, "action.prior=somewhere/prior.h5")
+    assert auto.wants_auto(cfg) == "" and str(auto.resolve(cfg).action.prior) == "somewhere/prior.h5"
+    assert not (tmp_path / "mlflow.db").exists()  # nothing was looked up or trained
+
+
+def test_auto_outside_jt_run_is_one_line_error():
+    from toolkit.priors.io import load_prior
+
+    with pytest.raises(JtError, match="resolved by jt run") as e:
+        load_prior("auto", kind="pvae")
+    assert "\n" not in str(e.value)
