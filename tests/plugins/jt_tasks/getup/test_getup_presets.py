@@ -1,0 +1,40 @@
+"""experiment=smoke / quick / paper for task=getup compose to what docs/getup.md says."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+
+def cfg(experiment: str, *more: str):
+    from toolkit.config import compose, validate
+
+    return validate(compose(["task=getup", f"experiment={experiment}", *more]))
+
+
+@pytest.mark.parametrize("experiment", ["smoke", "quick", "paper"])
+def test_no_episode_is_cut_by_the_iteration(experiment):
+    """Each env collects at least one whole longest episode (7.6 s authored curve + 3 s standing at
+    30 Hz = 318 control steps) per PPO iteration, except at smoke scale."""
+    c = cfg(experiment, "action.prior=unused") if experiment == "paper" else cfg(experiment)
+    a = c.agent
+    per_env = a.samples_per_iteration / (a.n_workers * a.envs_per_worker)
+    longest = math.ceil((max(c.task.authored_durations) + c.task.t_stand) * c.sim.control_hz)
+    assert longest == 318
+    if experiment != "smoke":
+        assert per_env >= longest
+
+
+def test_paper_preset_has_the_papers_budgets():
+    c = cfg("paper", "action.prior=unused")
+    assert c.action.name == "cvae" and c.agent.total_samples == 100_000_000  # 003 §3.4, §5.6
+    assert c.agent.n_workers == 16 and c.agent.minibatch_size == 256  # 003 §5.6
+    assert c.task.eval_locations == 100 and list(c.task.eval_regions) == ["flat", "easy", "medium", "hard"]
+    assert c.curriculum.name == "terrain" and c.curriculum.successes_to_unlock == 200  # 003 §5.4
+
+
+def test_quick_preset_visits_every_region_on_a_fixed_schedule():
+    c = cfg("quick")
+    assert c.agent.total_samples // c.curriculum.fixed_every_samples >= 3  # hard unlocked before the end
+    assert c.action.name == "raw" and c.task.eval_locations >= 5
