@@ -224,10 +224,10 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
     names = {rid: store.get_run(rid).info.run_name for _, rid, _ in per_cell}
     note = "\n".join([
         f"**Comparison** of {label} ({len(per_cell)} runs): mean ± std over seeds.", "",
-        f"Reproduce: `{command}`", "",
         describe.table(["variant", "n", *keys, "runs"],
                        [[r["variant"], r["n"], *(f"{r[k][0]:.4g} ± {r[k][1]:.2g}" for k in keys),
                          ", ".join(names.get(x) or x for x in r["runs"])] for r in rows]), "",
+        f"Reproduce: `{command}`", "",
         "Metrics: `<variant>/<metric>_mean` and `_std`; the bar chart is the artifact `compare.png`, "
         "the numbers `compare.h5`; the compared runs are this run's children."])
     store.set_tags(run_id, {describe.NOTE: note + "\n"})

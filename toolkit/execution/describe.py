@@ -76,11 +76,12 @@ def outer(cfg: Any, command: str, metrics: Optional[Mapping[str, float]] = None,
     budget = cfg.search.get("budget", None)
     what = (f"task `{t}` searched by `{s}`" + (f" (budget {budget} evaluations)" if budget is not None else "")
             if nested else f"one evaluation of task `{t}`, in this run (search `{s}`)")
-    lines = [f"**{t} · {s} · seed {cfg.seed}**: {what}.", "", f"Reproduce: `{command}`", ""]
+    lines = [f"**{t} · {s} · seed {cfg.seed}**: {what}.", ""]  # the UI shows ~3 lines before "Show more"
     if metrics is None:
         lines.append("Running; the headline metrics appear here when it finishes.")
     else:
         lines.append(table(["metric", "value"], headline(metrics, keys)))
+    lines += ["", f"Reproduce: `{command}`"]
     pics = _pictures(pictures)
     where = []
     if pics:

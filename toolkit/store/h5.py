@@ -115,7 +115,7 @@ def preview(path: str | os.PathLike, max_lines: int = 400) -> str:
         The text, ending with a newline (what ``<name>.h5.txt`` beside an artifact holds).
     """
     path = Path(path)
-    lines = [f"{path.name}: HDF5, {path.stat().st_size} bytes (name  shape dtype  [= values]; @attribute = value)"]
+    lines = [f"{path.name}: HDF5, {path.stat().st_size} bytes", "# name  shape dtype  [= values]    @attribute = value"]
 
     def attrs(obj: Any, pad: str) -> None:
         for k, v in obj.attrs.items():

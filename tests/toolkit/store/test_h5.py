@@ -56,4 +56,4 @@ def test_preview_lists_groups_datasets_shapes_and_attributes(tmp_path):
         f.create_dataset("nothing", data=h5py.Empty("f8"))
     assert "nothing  empty float64" in h5.preview(tmp_path / "e.h5")
     many = h5.write(tmp_path / "m.h5", {f"d{i}": i for i in range(50)})
-    assert h5.preview(many, max_lines=10).splitlines()[-1] == "… 41 more lines"
+    assert h5.preview(many, max_lines=10).splitlines()[-1] == "… 42 more lines"
