@@ -59,7 +59,12 @@ class History:
         self.records.append(record)
 
     def evaluations(self) -> list[Evaluation]:
-        return [r.evaluation for r in sorted(self.records, key=lambda r: r.index)]
+        """Every evaluation in index order, each with its ``run_id``."""
+        out = []
+        for r in sorted(self.records, key=lambda r: r.index):
+            r.evaluation.run_id = r.evaluation.run_id or r.run_id
+            out.append(r.evaluation)
+        return out
 
     # ---- persistence -----------------------------------------------------------------------
     def arrays(self) -> dict[str, Any]:

@@ -53,6 +53,8 @@ class Evaluation:
             with the final value in ``metrics``; ``step`` is the curve's x (samples, for training).
         artifacts: names of files in the workdir to log (default: every file there).
         point: the parameters evaluated (filled in by the runner).
+        run_id: its nested MLflow run, '' when logged on the outer run (filled in by the runner
+            for ``summarize`` / ``summary_artifacts`` / ``summary_table``).
     """
 
     metrics: dict[str, float] = dataclasses.field(default_factory=dict)
@@ -63,6 +65,7 @@ class Evaluation:
     history: dict[str, list[tuple]] = dataclasses.field(default_factory=dict)
     artifacts: Optional[list[str]] = None
     point: dict[str, float] = dataclasses.field(default_factory=dict)
+    run_id: str = dataclasses.field(default="", compare=False)
 
 
 class Task(Plugin, abc.ABC):

@@ -73,7 +73,7 @@ class JumpEnv(CharacterEnv):
 
     #: looks at the root from the run-up side, a little above: the mat and the bar wall, which
     #: stand beyond the athlete from there, never hide it (the simulator's default side view does)
-    CAMERA = {"distance": 4.0, "yaw": 180.0, "pitch": -20.0}
+    CAMERA = {"distance": 3.0, "yaw": 180.0, "pitch": -15.0}
 
     # ------------------------------------------------------------------ set-up (scene, initial state)
     def setup(self) -> None:

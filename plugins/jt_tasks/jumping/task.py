@@ -246,6 +246,7 @@ class JumpTask(PolicyTask):
     def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
         ro["feature_quat"] = env.tracker.stage2(env.suite.rotation())
         ro["feature_angle"] = env.tracker.stage1()
+        ro["feature_time"] = float(env.tracker.time)
         data = {"feature_quat": np.asarray(ro["feature_quat"], dtype=float),
                 "feature_angle": np.array([ro["feature_angle"]])}
         attrs = {"features": {k: float(v) for k, v in spec.features.items()}, "kind": spec.kind,
@@ -276,10 +277,66 @@ class JumpTask(PolicyTask):
             metrics.update(novelty_metrics(ro["feature_quat"], spec.policy_features, spec.reward_terms))
             metrics["init_eval_index"] = float(init.eval_index)
         history = {"mean_return": return_curve(trained), **jump_curves(hooks, res)}
+        self._write_peak(ro, workdir)
         if not math.isfinite(angle):
             return Evaluation(metrics={k: v for k, v in metrics.items() if math.isfinite(v)}, failed=True,
                               reason="the deterministic jump never crossed the bar plane", history=history)
         return Evaluation(metrics=metrics, features=[angle], history=history)
+
+    def _write_peak(self, ro: dict, workdir: Path) -> None:
+        """``peak.png``: the rendered control step nearest the CoM's crossing of the bar plane
+        (the strategy gallery's picture, ``000`` Fig. 7); nothing when it never crossed."""
+        from jt_tasks.jumping.gallery import PEAK
+
+        t, frames = float(ro.get("feature_time", math.nan)), ro.get("frames") or []
+        if not math.isfinite(t) or not frames:
+            return
+        import imageio.v3 as iio
+
+        i = int(np.argmin(np.abs(np.asarray(ro["time"], dtype=float)[: len(frames)] - t)))
+        iio.imwrite(Path(workdir) / PEAK, np.asarray(frames[i])[..., :3].astype(np.uint8))
+
+    def extra_artifacts(self, workdir: Path) -> list[str]:
+        """``peak.png`` when the jump crossed the bar plane."""
+        from jt_tasks.jumping.gallery import PEAK
+
+        return [PEAK] if (Path(workdir) / PEAK).is_file() else []
+
+    # ------------------------------------------------------------------ the search's summary
+    def strategies(self, items: list[dict]) -> list[dict]:
+        """The distinct strategies among ``items`` (``jt_tasks.jumping.gallery.strategies``)."""
+        from jt_tasks.jumping.features import angle_distance
+        from jt_tasks.jumping.gallery import strategies
+
+        return strategies(items, float(self.params.distinct_threshold), angle_distance)
+
+    def _items(self, evaluations: Any, folder: Optional[Path] = None) -> list[dict]:
+        """``gallery.strategies``' input: one dict per evaluation (its files in ``folder.parent``)."""
+        return [{"index": i, "features": list(ev.features), "metrics": dict(ev.metrics), "point": dict(ev.point),
+                 "run_id": ev.run_id, "workdir": str(Path(folder).parent / f"eval_{i:04d}") if folder else ""}
+                for i, ev in enumerate(evaluations)]
+
+    def summarize(self, evaluations: Any, workdir: Path) -> dict[str, Any]:
+        """The search's strategy count (``000`` §7.1.1: 6 distinct strategies in the first ten
+        samples) and how many evaluations gave a feature at all."""
+        items = self._items(evaluations)
+        with_feature = sum(1 for it in items if it["features"] and math.isfinite(float(it["features"][0])))
+        return {"n_strategies": float(len(self.strategies(items))), "n_with_feature": float(with_feature)}
+
+    def summary_artifacts(self, evaluations: Any, folder: Path) -> list[Path]:
+        """The strategy gallery (``000`` Fig. 7): per strategy its pose over the bar, labelled, and
+        its GIF; ``gallery.png`` with all of them; ``strategies.json``."""
+        from jt_tasks.jumping import gallery
+
+        found = self.strategies(self._items(evaluations, folder))
+        return gallery.write(found, Path(folder) / "gallery") if found else []
+
+    def summary_table(self, evaluations: Any) -> Optional[tuple[list[str], list[list]]]:
+        """One row per distinct strategy (``jt show RUN_ID`` prints it)."""
+        from jt_tasks.jumping import gallery
+
+        found = self.strategies(self._items(evaluations))
+        return gallery.table(found) if found else None
 
 
 class HighJumpTask(JumpTask):
