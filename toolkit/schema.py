@@ -45,6 +45,9 @@ class RunConfig:
     """Name of the experiment preset applied (set by ``experiment=...``)."""
     run_name: Optional[str] = None
     """Optional MLflow run name."""
+    cost: Optional[str] = None
+    """What the run costs, in one line ``jt run`` prints before it starts (a preset says it, e.g.
+    the paper's budget and the cheaper experiment to try on a laptop)."""
 
 
 def _load_class(ref: str) -> type:

@@ -148,6 +148,8 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     workdir = store.workdir(run_id)
     hist_path = workdir / "search_history.h5"
     _log(f"jt: run {run_id} ({experiment}){' resumed' if resumed else ''}; store {store.root}")
+    if cfg.get("cost"):
+        _log(f"jt: cost: {cfg.cost}")
     try:
         with _Terminate():
             if resumed:

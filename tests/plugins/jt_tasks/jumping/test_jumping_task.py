@@ -60,3 +60,13 @@ def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
 
 
 # Stage 2 (task.stage=2): tests/plugins/jt_tasks/jumping/test_stage2.py
+
+
+def test_the_paper_budget_says_its_cost_and_the_laptop_way():
+    from toolkit.config import compose
+
+    default = compose(["task=highjump", "search=bds"])
+    assert "experiment=laptop" in default.cost and "six hours" in default.cost
+    assert str(default.action.name) == "pvae" and str(default.action.prior) == "auto"  # runs as typed
+    laptop = compose(["task=highjump", "search=bds", "experiment=laptop"])
+    assert laptop.get("cost") is None and laptop.search.budget == 10 and laptop.curriculum.z_freeze == 0.55
