@@ -50,11 +50,32 @@ def write_takeoff_state(path: str | Path, q_world: np.ndarray, qd_world: np.ndar
 
 
 def read_takeoff_state(path: str | Path) -> Any:
-    """The file as a ``jt_tasks.takeoff.state.TakeoffState`` (features = the achieved ones)."""
+    """The file as a ``jt_tasks.takeoff.state.TakeoffState`` (features = the achieved ones).
+
+    Raises:
+        JtError: one line when the file is not HDF5, or lacks or mangles one of ``q``, ``qd``,
+            ``time``, ``foot``, ``features`` (e.g. a truncated copy or another kind of file).
+    """
     from jt_tasks.takeoff.state import TakeoffState
+    from toolkit.errors import JtError
     from toolkit.store import h5
 
-    d = h5.read(Path(path))
-    return TakeoffState(q=np.asarray(d["q"], dtype=float), qd=np.asarray(d["qd"], dtype=float),
-                        time=float(d["time"]), foot=str(d["foot"]),
-                        features={k: float(v) for k, v in d["features"].items()})
+    what = f"task.takeoff_from={path}"
+    hint = "give a task=runup run id, its folder, or its takeoff_state.h5 (make one with: jt run task=runup)"
+    try:
+        d = h5.read(Path(path))
+    except (OSError, ValueError) as e:
+        raise JtError(f"{what}: not a readable HDF5 file ({str(e).splitlines()[0]}); {hint}") from e
+    missing = [k for k in ("q", "qd", "time", "foot", "features") if k not in d]
+    if missing:
+        raise JtError(f"{what}: not a take-off state (no {', '.join(missing)}); {hint}")
+    try:
+        q, qd = np.asarray(d["q"], dtype=float).ravel(), np.asarray(d["qd"], dtype=float).ravel()
+        features = {k: float(v) for k, v in dict(d["features"]).items()}
+        ts = TakeoffState(q=q, qd=qd, time=float(d["time"]), foot=str(d["foot"]), features=features)
+    except (TypeError, ValueError) as e:
+        raise JtError(f"{what}: a malformed take-off state ({type(e).__name__}: {e}); {hint}") from e
+    if len(q) < 7 or len(qd) < 6 or not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+        raise JtError(f"{what}: a malformed take-off state (q has {len(q)} values, qd {len(qd)}, "
+                      f"or one is not finite); {hint}")
+    return ts

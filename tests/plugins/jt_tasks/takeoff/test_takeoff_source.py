@@ -100,3 +100,27 @@ def test_a_run_without_the_file_says_so(tmp_path):
     store.end_run(rid)
     with pytest.raises(JtError, match=r"no take-off state \(no takeoff_state.h5 artifact\); is it a task=runup run"):
         source.resolve(rid, str(tmp_path))
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"garbage, not HDF5", "not a readable HDF5 file"),
+    (None, "not a take-off state \\(no q, qd, time, foot, features\\)"),
+    ({"q": np.zeros(3), "qd": np.zeros(3), "time": 0.0, "foot": "right", "features": {}}, "malformed"),
+    ({"q": np.full(43, np.nan), "qd": np.zeros(34), "time": 0.0, "foot": "right", "features": {}}, "malformed"),
+])
+def test_a_bad_takeoff_file_is_one_line_error_before_a_run_opens(content, message, tmp_path):
+    from toolkit.config import compose
+    from toolkit.errors import JtError
+    from toolkit.execution.runner import run
+    from toolkit.store import h5
+
+    path = tmp_path / "takeoff_state.h5"
+    if isinstance(content, bytes):
+        path.write_bytes(content)
+    else:
+        h5.write(path, content or {"other": np.zeros(2)})
+    store = tmp_path / "store"
+    with pytest.raises(JtError, match=message) as e:
+        run(compose(["task=highjump", "experiment=smoke", f"task.takeoff_from={path}", f"store={store}"]))
+    assert "\n" not in str(e.value)
+    assert not (store / "runs").exists()  # no run was opened
