@@ -52,14 +52,18 @@ class IterationStats(dict):
         visits: one dict per batch row whose env reported its state (an env method
             ``visit_state()`` returning an array; none by default): ``state``, ``env``, ``step``,
             ``value`` and ``target`` as in ``starts`` (spacetime bounds eq 12's candidates).
+        model: the learner's actor-critic after this iteration's update (read it, e.g. to evaluate
+            the deterministic policy every N iterations; do not train it), or None.
     """
 
     def __init__(self, scalars: dict[str, float], episodes: list[dict[str, float]],
-                 starts: Optional[list[dict[str, float]]] = None, visits: Optional[list[dict[str, Any]]] = None) -> None:
+                 starts: Optional[list[dict[str, float]]] = None, visits: Optional[list[dict[str, Any]]] = None,
+                 model: Any = None) -> None:
         super().__init__(scalars)
         self.episodes = episodes
         self.starts = [] if starts is None else starts
         self.visits = [] if visits is None else visits
+        self.model = model
 
 
 @dataclasses.dataclass
@@ -390,7 +394,7 @@ def train(
             if on_iteration is not None:
                 visits = [{**v, "value": float(batch["values"][v["step"], v["env"]]),
                            "target": float(targets[v["step"], v["env"]])} for v in batch.get("visits", [])]
-                attrs = on_iteration(iteration, samples, IterationStats(stats, eps, starts, visits))
+                attrs = on_iteration(iteration, samples, IterationStats(stats, eps, starts, visits, model))
                 if attrs:
                     env_attrs.update(attrs)
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)

@@ -6,7 +6,11 @@ early by the spacetime bounds (``termination: bounds``, 002 §3.2 eq 2, reward 1
 terms) or, as the DeepMimic baseline of 002 Table 1, by a forbidden ground contact with
 DeepMimic's imitation reward (``termination: contact``). Then the deterministic policy is
 evaluated as in 002 Table 1: bounds off, up to ``eval_time_limit`` (20 s), failing only on a
-forbidden ground contact; the metric is ``survival_s``. docs/spacetime.md.
+forbidden ground contact; the metric is ``survival_s``. After every PPO iteration the start
+distribution adapts (002 §4.3, ``sampling.StartSampler``): start phases by eq 11 (on with bounds)
+and, with ``evolution``, start states from eq 12's per-segment buffers; the distribution per
+iteration is logged (``start_sampling.h5`` / ``.png``). ``mix`` gives eq 13's reward.
+docs/spacetime.md.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from typing import Any, ClassVar, Optional
 
 import numpy as np
 
+from toolkit.config import group_of
 from toolkit.interfaces.task import Evaluation
 
 from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask
@@ -94,6 +99,8 @@ class SpacetimeConfig(PolicyConfig):
     """Link names allowed on the ground in the evaluation and the contact arm (["all"]: any); null: per clip (authors' code: walk feet, cartwheel feet and hands, crawl all but root/chest/neck, roll all)."""
     filmstrip_frames: int = 4
     """Frames of the final rollout's filmstrip (ours)."""
+    eval_every: int = 10
+    """PPO iterations between evaluations during training, for survival_s vs samples and samples_to_20s (authors' code: every 10; 0: only the final one)."""
     mix: Optional[float] = None
     """Eq 13 weight w_s: reward (1 - w_s) imitation + w_s style in either arm (002 §5.3.1 Table 2: 0.5-0.8); null: survival x style / imitation."""
     importance_sampling: Optional[bool] = None
@@ -169,6 +176,7 @@ class SpacetimeConfig(PolicyConfig):
             require(v is None or (finite(v) and 0.0 <= v <= 1.0), f"task.{key}", v, "a number in [0, 1]")
         require(self.evolution_warmup is None or int(self.evolution_warmup) >= 0, "task.evolution_warmup",
                 self.evolution_warmup, "null or an iteration count >= 0")
+        require(int(self.eval_every) >= 0, "task.eval_every", self.eval_every, "an iteration count >= 0 (0: off)")
         require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
                 "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,
                                                        self.filmstrip_height), "frames >= 0, sizes > 0")
@@ -219,16 +227,22 @@ class SpacetimeTask(PolicyTask):
                              sampling={"evolution": bool(p.evolution)}, sim=sim, action=action)
 
     def training(self, spec: Any, ctx: Any) -> Hooks:
-        """PPO's ``on_iteration``: eq 11 start weights and eq 12 buffers (``StartSampler``), every
-        iteration, sent to the envs as ``start_sampling``; the sampler's state rides in ``extra``."""
+        """PPO's ``on_iteration`` (``training.SpacetimeTraining``): eq 11 start weights and eq 12
+        buffers (``StartSampler``) every iteration, sent to the envs as ``start_sampling``, and
+        Table 1's evaluation every ``eval_every`` iterations; their state rides in ``extra``."""
+        import functools
+
+        from jt_tasks.policy.train import agent_config
         from jt_tasks.spacetime.sampling import StartSampler
+        from jt_tasks.spacetime.training import SpacetimeTraining
 
         params = self.params.sampling_params()
         extra: dict[str, Any] = {}
-        if not (params.importance or params.evolution):
-            return Hooks(extra=extra, state={"sampler": None})
-        sampler = StartSampler(params, extra, ctx.seed)
-        return Hooks(on_iteration=sampler.update, extra=extra, state={"sampler": sampler})
+        sampler = StartSampler(params, extra, ctx.seed) if (params.importance or params.evolution) else None
+        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
+        hook = SpacetimeTraining(sampler, functools.partial(self.env_class, spec, seed=ctx.seed),
+                                 self.final_options(None), int(self.params.eval_every), extra, ctx.progress, total)
+        return Hooks(on_iteration=hook, extra=extra, state={"sampler": sampler, "training": hook})
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def final_options(self, env: Any) -> Optional[dict]:
@@ -261,6 +275,15 @@ class SpacetimeTask(PolicyTask):
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         history = {"mean_return": return_curve(trained),
                    "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
+        hook = hooks.state.get("training")
+        rows = hook.history() if hook is not None else np.zeros((0, 3))
+        if len(rows):
+            from jt_tasks.spacetime.training import samples_to_20s
+
+            history["survival_s"] = [(int(r[0]), float(r[1])) for r in rows]
+            reached = samples_to_20s(rows)
+            if reached is not None:
+                metrics["samples_to_20s"] = reached
         sampler = hooks.state.get("sampler")
         h = sampler.history() if sampler is not None else None
         if h is not None:

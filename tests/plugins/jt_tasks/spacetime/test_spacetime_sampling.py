@@ -204,3 +204,19 @@ def test_code_reading_fills_in_the_authors_defaults():
     t, _ = task("task.termination=contact")
     p = t.params.sampling_params()
     assert (p.share, p.warmup, p.decay, p.importance, p.evolution) == (1.0, 0, 1.0, False, False)
+
+
+def test_evaluation_during_training_ends_on_the_final_policys_survival(tmp_path):
+    ev = evaluate(tmp_path, "task.eval_every=1", "task.evolution=false")
+    curve = ev.history["survival_s"]
+    assert [s for s, _ in curve] == [64, 128, 192]  # after every iteration
+    assert all(0 < v <= 1.0 for _, v in curve)  # smoke: a 1 s evaluation
+    assert curve[-1][1] == pytest.approx(ev.metrics["survival_s"])  # same policy, same deterministic start
+    assert "samples_to_20s" not in ev.metrics  # never survived
+
+
+def test_samples_to_20s_is_the_first_surviving_evaluation():
+    from jt_tasks.spacetime.training import samples_to_20s
+
+    rows = np.array([[4096, 3.0, 0], [8192, 20.0, 1], [12288, 7.0, 0], [16384, 20.0, 1]])
+    assert samples_to_20s(rows) == 8192 and samples_to_20s(rows[[0, 2]]) is None
