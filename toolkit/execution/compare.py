@@ -230,7 +230,7 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
         f"Reproduce: `{command}`", "",
         "Metrics: `<variant>/<metric>_mean` and `_std`; the bar chart is the artifact `compare.png`, "
         "the numbers `compare.h5`; the compared runs are this run's children."])
-    store.set_tags(run_id, {describe.NOTE: note + "\n"})
+    store.set_tags(run_id, {describe.NOTE: describe.fit(note + "\n")})
     return CompareResult(table, run_id, store.root, rows)
 
 

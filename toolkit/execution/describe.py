@@ -14,6 +14,18 @@ from typing import Any, Iterable, Mapping, Optional, Sequence
 
 NOTE = "mlflow.note.content"
 PICTURES = (".png", ".gif", ".mp4", ".jpg", ".svg")
+LIMIT = 8000
+"""Characters MLflow keeps of a tag value (it cuts longer ones, mid-row of a table)."""
+MAX_ROWS = 40
+"""Rows of a table in a description (the rest: in its file, and ``jt show``)."""
+
+
+def fit(text: str, limit: int = LIMIT) -> str:
+    """``text`` cut at a line boundary to at most ``limit`` characters, saying so."""
+    if len(text) <= limit:
+        return text
+    tail = "\n\n… (cut to fit MLflow's 8000 characters; `jt show RUN_ID` prints everything)\n"
+    return text[: text.rfind("\n", 0, limit - len(tail))] + tail
 
 
 def provenance_tags(command: str) -> dict[str, str]:
@@ -43,8 +55,11 @@ def table(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
     def cell(v: Any) -> str:
         return fmt(v).replace("|", "\\|").replace("\n", " ")
 
+    rows = list(rows)
     lines = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows[:MAX_ROWS]]
+    if len(rows) > MAX_ROWS:
+        lines += ["", f"… {len(rows) - MAX_ROWS} more rows (all of them: `jt show RUN_ID`)"]
     return "\n".join(lines)
 
 
@@ -92,7 +107,7 @@ def outer(cfg: Any, command: str, metrics: Optional[Mapping[str, float]] = None,
         lines += ["", "Pictures: " + "; ".join(where) + "."]
     if summary:
         lines += ["", summary]
-    return "\n".join(lines).strip() + "\n"
+    return fit("\n".join(lines).strip() + "\n")
 
 
 def evaluation(index: int, parent: str, point: Mapping[str, float], seed: int, metrics: Mapping[str, float],
@@ -106,7 +121,7 @@ def evaluation(index: int, parent: str, point: Mapping[str, float], seed: int, m
     pics = _pictures(artifacts)
     if pics:
         lines += ["", "Pictures (artifacts): " + ", ".join(f"`{p}`" for p in pics) + "."]
-    return "\n".join(lines) + "\n"
+    return fit("\n".join(lines) + "\n")
 
 
 def ensure_experiment(store: Any, task: str, task_cls: Any) -> str:

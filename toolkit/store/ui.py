@@ -43,7 +43,9 @@ def serve(root: Path, port: int) -> int:
 
         Store(root)
     cmd, env = command(root, port)
-    proc = subprocess.Popen(cmd, env=env)
+    # its own process group: stopping jt stops MLflow's server process and its worker together,
+    # also where a shell started jt in the background (SIGINT ignored there)
+    proc = subprocess.Popen(cmd, env=env, start_new_session=True)
 
     def stop(signum: int, frame: Any) -> None:
         raise KeyboardInterrupt
@@ -52,12 +54,16 @@ def serve(root: Path, port: int) -> int:
     try:
         return proc.wait()
     except KeyboardInterrupt:
-        proc.send_signal(signal.SIGINT)  # MLflow stops its uvicorn worker on SIGINT
-        try:
-            proc.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        for sig, wait_s in ((signal.SIGTERM, 15.0), (signal.SIGKILL, 5.0)):
+            try:
+                os.killpg(proc.pid, sig)
+            except ProcessLookupError:
+                break
+            try:
+                proc.wait(timeout=wait_s)
+                break
+            except subprocess.TimeoutExpired:
+                continue
         return 0
     finally:
         signal.signal(signal.SIGTERM, old)

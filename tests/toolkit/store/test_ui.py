@@ -1,4 +1,5 @@
-"""jt ui: MLflow's UI with one worker and no job runners; SIGTERM stops it with the server."""
+"""jt ui: MLflow's UI with one worker and no job runners; SIGTERM stops it with the server, also
+when jt was started as a shell's background job."""
 
 import os
 import signal
@@ -36,8 +37,10 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
     store = Store(tmp_path / "s")
     store.end_run(store.start_run("exp", run_name="r"))
     port = free_port()
+    # as a shell's background job: SIGINT ignored, inherited by everything jt starts
     proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "ui", f"store={tmp_path / 's'}", "--port", str(port)],
-                            env=jt_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            env=jt_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     try:
         deadline, up = time.monotonic() + 120, False
         while time.monotonic() < deadline and not up and proc.poll() is None:
@@ -52,8 +55,10 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
         body = urllib.request.urlopen(f"http://127.0.0.1:{port}/ajax-api/2.0/mlflow/experiments/search?max_results=10",
                                       timeout=10).read().decode()
         assert '"exp"' in body
+        t0 = time.monotonic()
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)
+        assert time.monotonic() - t0 < 10  # stopped, not waited out and killed
         time.sleep(1)
         assert not [k for k in kids if os.path.exists(f"/proc/{k[0]}")], "the server outlived jt ui"
     finally:
