@@ -110,3 +110,49 @@ def plot_curves(path: Path, time: np.ndarray, features: np.ndarray, targets: np.
     fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)
+
+
+def replay_reference(env: Any, curve: str) -> dict[str, np.ndarray]:
+    """The reference clip of ``curve`` replayed kinematically through the env's reward (issue check:
+    the early termination must not fire on the reference itself): at every control step of ``[0, T]``
+    the clip's pose (lifted onto the ground) is set, and the reward terms are read as in a step.
+
+    Returns:
+        ``time`` ``(n,)``, ``r_task`` ``(n,)``, one ``(n,)`` array per reward term, ``head_height``
+        ``(n,)`` (lowest point of the head link above the ground, m).
+    """
+    import math as _m
+
+    from jt_tasks.getup.curves import load_getup_clip
+    from jt_tasks.getup.initial import lift_to_ground
+    from jt_tasks.takeoff.state import reference_state
+
+    env.reset(seed=0, options={"kind": "clip", "curve": curve})
+    c = env.curve
+    if not c.clip:
+        raise ValueError(f"curve {curve!r} has no reference clip")
+    clip = load_getup_clip(c.clip, c.mirrored)
+    n = int(_m.floor(c.duration * env.control_hz)) + 1
+    rows: list[dict[str, float]] = []
+    for k in range(n):
+        t = min(max(k / env.control_hz, 1.0 / 120.0), float(clip.times[-1]) - 1.0 / 120.0)
+        p, r, j, v, w, jv = reference_state(clip, t)
+        links = env.sim.link_states() if k else None
+        env.sim.reset(lift_to_ground(np.concatenate([p, r, j])), np.concatenate([v, w, jv]))
+        env._prev_links, env._m = links, None
+        env.t_offset = k / env.control_hz - float(env.sim.time)  # the curve's clock at this frame
+        rec = env.record_now()
+        values = {name: float(term(rec)) for name, term in env.terms.items()}
+        rows.append({"time": k / env.control_hz,
+                     "r_task": float(np.prod([x for name, x in values.items() if name not in env.natural])),
+                     **values, "head_height": env._head_height()})
+    return {key: np.array([row[key] for row in rows]) for key in rows[0]}
+
+
+def longest_run(mask: np.ndarray) -> int:
+    """Length of the longest run of True in ``mask``."""
+    best = cur = 0
+    for m in np.asarray(mask, bool):
+        cur = cur + 1 if m else 0
+        best = max(best, cur)
+    return best

@@ -71,3 +71,26 @@ def test_curves_plot(tmp_path):
     E.plot_curves(tmp_path / "curves.png", t, f, f + 0.05, "test")
     img = iio.imread(tmp_path / "curves.png")
     assert img.shape[1] > 2 * img.shape[0] and img.std() > 5
+
+
+@pytest.mark.parametrize("curve", ["facedown", "faceup_mirror"])
+def test_reference_clip_replayed_through_the_reward_never_terminates(curve):
+    """The issue's check 2: a kinematic replay of the curve's own clip scores well and the
+    r_task < 0.1 rule (sustained > 300 ms, 003 §5.3) never fires on it."""
+    from toolkit import plugins
+    from toolkit.config import compose, validate
+
+    cfg = validate(compose(["task=getup", "action=raw", "task.train_regions=flat", "task.n_fallen=1",
+                            "task.settle_max=0.5"]))
+    env = plugins.load("task", "getup")(cfg).make_env(None, seed=0)
+    try:
+        r = E.replay_reference(env, curve)
+        assert len(r["r_task"]) == int(env.curve.duration * 30) + 1
+        np.testing.assert_allclose(r["r_task"], np.prod([r[k] for k in r if k.startswith("getup_")], axis=0))
+        assert E.longest_run(r["r_task"] < 0.1) <= 9
+        assert r["r_task"].mean() > 0.6 and r["r_task"].min() > 0.2  # measured: 0.75/0.48, 0.70/0.29
+        # starts and ends on the curve, within the few cm the pose is lifted (the clips dip into their floor)
+        assert r["getup_height"][0] > 0.9 and r["getup_height"][-1] > 0.9
+    finally:
+        env.close()
+    assert E.longest_run(np.array([0, 1, 1, 0, 1, 1, 1, 0], bool)) == 3
