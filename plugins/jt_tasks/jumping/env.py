@@ -71,9 +71,17 @@ class EnvSpec:
 class JumpEnv(CharacterEnv):
     """High / obstacle / long jump from a take-off state (000 §6.1), sparse product reward."""
 
-    #: looks at the root from the run-up side, a little above: the mat and the bar wall, which
-    #: stand beyond the athlete from there, never hide it (the simulator's default side view does)
-    CAMERA = {"distance": 3.0, "yaw": 180.0, "pitch": -15.0}
+    #: distance (m) and pitch (deg) of the view along the bar (``render_frame``)
+    CAMERA = {"distance": 3.5, "pitch": -8.0}
+
+    def render_frame(self, width: int, height: int) -> np.ndarray:
+        """RGB frame ``(height, width, 3)`` uint8 looking along the bar (its wall edge-on, below the
+        athlete as the CoM crosses its plane): the side view of a clearance, as ``000`` Fig. 7."""
+        from toolkit.render import Camera
+
+        along = self.suite.rotation()[:, 2]
+        yaw = math.degrees(math.atan2(float(along[0]), float(along[2])))
+        return self.sim.render(width, height, Camera(yaw=yaw, **self.CAMERA))
 
     # ------------------------------------------------------------------ set-up (scene, initial state)
     def setup(self) -> None:

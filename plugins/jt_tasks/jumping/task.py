@@ -83,6 +83,11 @@ class JumpConfig(PolicyConfig):
     """Substeps between contact checks (ours: every 600 Hz substep)."""
     distinct_threshold: float = 0.5
     """rad: Stage-1 features closer than this count as one strategy (ours)."""
+    final_fallback: bool = True
+    """Ours: when the deterministic jump at the reached bar never crosses its plane (a budget that
+    ends right after the curriculum raised the bar, before the policy learnt the new height),
+    roll it out again one Δz lower, down to z_min, and report the first that crosses:
+    ``bar_height_reached`` is that bar, ``bar_height_trained`` the curriculum's."""
 
     def check(self) -> None:
         """Range checks (one ``JtError`` line each)."""
@@ -109,7 +114,10 @@ class JumpConfig(PolicyConfig):
 class JumpTask(PolicyTask):
     """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
 
-    key_metrics: ClassVar[tuple[str, ...]] = ("strategy_angle", "bar_height_reached", "success_rate")
+    key_metrics: ClassVar[tuple[str, ...]] = ("n_strategies", "n_with_feature", "strategy_angle",
+                                              "bar_height_reached", "success_rate")
+    """A search's strategy count and evaluations with a feature (``summarize``; what ``jt compare
+    --vary search=bds,random`` tabulates), then each evaluation's own."""
     kind: ClassVar[str] = "highjump"
     feature_names: ClassVar[tuple[str, ...]] = ("alpha", "omega_x", "omega_z", "v_z")
     Config: ClassVar[type] = JumpConfig
@@ -240,13 +248,28 @@ class JumpTask(PolicyTask):
         from jt_tasks.jumping.train import after_training
 
         after_training(hooks, trained.result)
-        for k, v in hooks.state["cur"].env_attrs().items():  # the reached difficulty
+        cur = hooks.state["cur"]
+        for k, v in cur.env_attrs().items():  # the reached difficulty
             setattr(env, k, v)
+        self._fallback = (float(cur.params.z_min), float(cur.params.dz), hooks.state["z_attr"])
+
+    def retry_rollout(self, env: Any, ro: dict) -> bool:
+        """``task.final_fallback``: one Δz lower when the jump never crossed the plane (not below z_min)."""
+        fallback = getattr(self, "_fallback", None)
+        if not self.params.final_fallback or fallback is None or math.isfinite(env.tracker.stage1()):
+            return False
+        z_min, dz, attr = fallback
+        z = round(float(env.difficulty) - dz, 9)
+        if z < z_min - 1e-9:
+            return False
+        setattr(env, attr, z)
+        return True
 
     def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
         ro["feature_quat"] = env.tracker.stage2(env.suite.rotation())
         ro["feature_angle"] = env.tracker.stage1()
         ro["feature_time"] = float(env.tracker.time)
+        ro["final_z"] = float(env.difficulty)
         data = {"feature_quat": np.asarray(ro["feature_quat"], dtype=float),
                 "feature_angle": np.array([ro["feature_angle"]])}
         attrs = {"features": {k: float(v) for k, v in spec.features.items()}, "kind": spec.kind,
@@ -261,7 +284,8 @@ class JumpTask(PolicyTask):
         succ = [r for _, _, r in hooks.state["z_hist"] if math.isfinite(r)]
         angle = float(ro["feature_angle"])
         metrics = {
-            "strategy_angle": angle, "bar_height_reached": float(hooks.state["cur"].z),
+            "strategy_angle": angle, "bar_height_reached": float(ro.get("final_z", hooks.state["cur"].z)),
+            "bar_height_trained": float(hooks.state["cur"].z),
             "mean_return": float(ro["return"]),
             "train_mean_return": last_finite(res.history.get("mean_return", [])),
             "success_rate": succ[-1] if succ else 0.0,

@@ -104,6 +104,11 @@ class PolicyTask(Task):
         """Reset options of the deterministic rollout."""
         return None
 
+    def retry_rollout(self, env: Any, ro: dict) -> bool:
+        """After a deterministic rollout ``ro``: True to roll out again, after changing ``env`` (e.g.
+        an easier curriculum level). Default: never."""
+        return False
+
     def record(self, env: Any) -> dict[str, Any]:
         """What the rollout logs per control step: time, root pose ``(7,)`` and CoM ``(3,)``."""
         q, _ = env.sim.state()
@@ -156,8 +161,11 @@ class PolicyTask(Task):
         env = self.env_class(spec, seed=ctx.seed)
         try:
             self.final_env(env, hooks, trained)
-            ro = tr.rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width, p.filmstrip_height,
-                            self.final_options(env))
+            while True:
+                ro = tr.rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width,
+                                p.filmstrip_height, self.final_options(env))
+                if not self.retry_rollout(env, ro):
+                    break
             data, attrs = self.rollout_data(ro, env, spec)
             fps = float(getattr(env, "control_hz", 30.0))
         finally:

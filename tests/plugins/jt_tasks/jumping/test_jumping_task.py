@@ -69,4 +69,28 @@ def test_the_paper_budget_says_its_cost_and_the_laptop_way():
     assert "experiment=laptop" in default.cost and "six hours" in default.cost
     assert str(default.action.name) == "pvae" and str(default.action.prior) == "auto"  # runs as typed
     laptop = compose(["task=highjump", "search=bds", "experiment=laptop"])
-    assert laptop.get("cost") is None and laptop.search.budget == 10 and laptop.curriculum.z_freeze == 0.55
+    assert laptop.get("cost") is None and laptop.search.budget == 10 and laptop.curriculum.z_freeze == 0.5 and laptop.curriculum.z_min == 0.2
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_final_fallback_steps_down_one_dz_to_z_min(enabled):
+    from toolkit import plugins
+
+    task = plugins.load("task", "highjump")(_cfg(f"task.final_fallback={str(enabled).lower()}"))
+    env = task.make_env(seed=0)
+    try:
+        task._fallback = (0.2, 0.15, "bar_height")
+        env.bar_height = 0.5
+        env.reset(seed=0)  # no step: the tracker has not crossed
+        assert task.retry_rollout(env, {}) is enabled
+        if enabled:
+            env.reset(seed=0)
+            assert env.difficulty == pytest.approx(0.35)
+            assert task.retry_rollout(env, {}) and (env.reset(seed=0) or True)
+            assert env.difficulty == pytest.approx(0.2)
+            assert not task.retry_rollout(env, {})  # 0.05 would be below z_min
+            env.tracker.land(0.1, np.array([0.0, 0.0, 0.0, 1.0]))
+            env.bar_height = 0.5
+            assert not task.retry_rollout(env, {})  # it crossed: keep the rollout
+    finally:
+        env.close()
