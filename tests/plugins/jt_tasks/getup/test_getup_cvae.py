@@ -81,3 +81,22 @@ def test_getup_with_a_cvae_prior_trains_and_rolls_out(priors, tmp_path):
     assert 0.0 < ev.metrics["r_naturalness_mean"] <= 1.0  # eq 3 from the C-VAE's offsets
     for name in ("ppo.h5", "rollout.h5", "filmstrip.png", "motion.gif", "table1.h5", "curves.png"):
         assert name in ev.artifacts and (tmp_path / name).stat().st_size > 0
+
+
+def test_the_filter_without_learning_keeps_targets_smooth_and_natural(priors):
+    """The issue's check 3 at the initial policy's σ = 0.6 (003 §5.6): with the 0.2 filter r_natural
+    stays high and the PD targets move several times less per step than with β = 1 (no filter)."""
+    from jt_tasks.getup import evaluate as E
+    from toolkit import plugins
+
+    out = {}
+    for beta in (0.2, 1.0):
+        task = plugins.load("task", "getup")(getup_cfg("action=cvae", f"action.prior={priors['cvae']}",
+                                                       f"action.beta={beta}"))
+        env = task.make_env(None, seed=0)
+        try:
+            out[beta] = E.open_loop_noise(env, 0.6, 60, seed=0)
+        finally:
+            env.close()
+    assert out[0.2]["r_natural"] > 0.6 and out[1.0]["r_natural"] < 0.2  # measured: 0.83 vs 0.01
+    assert out[1.0]["target_change"] > 3 * out[0.2]["target_change"]  # measured: 0.61 vs 0.09 rad
