@@ -33,7 +33,7 @@ import numpy as np
 from jt_tasks.getup import features as F
 from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.initial import clip_pose, pick_curve
-from jt_tasks.getup.terrain import TerrainSpec, add_terrain, place_on_ground, sample_locations
+from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
 from jt_tasks.policy.env import CharacterEnv
 from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
@@ -129,7 +129,8 @@ class GetupEnv(CharacterEnv):
             q, qd = np.asarray(st["q"], float), np.asarray(st["qd"], float)
         else:
             q, qd = self.stand_state
-        if where is not None:  # a standing start on irregular terrain, feet not re-oriented (ours)
+        if where is not None:  # a standing start on irregular terrain, feet to the slope (003 §5.2)
+            q = orient_feet(self.sim, place_on_ground(self.sim, q, qd, where), qd)
             place_on_ground(self.sim, q, qd, where)
         else:
             self.sim.reset(np.array(q), np.array(qd))

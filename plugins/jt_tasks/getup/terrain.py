@@ -165,3 +165,45 @@ def place_on_ground(sim: Any, q: np.ndarray, qd: np.ndarray, xz: Any, clearance:
     q[1] += float(np.max(ground + clearance - np.asarray(lows)))
     sim.reset(q, np.asarray(qd, float))
     return q
+
+
+FEET = (("right_ankle", 5, 4), ("left_ankle", 11, 10))  #: (joint, foot link, its parent link) of the humanoid
+
+
+def ground_normal(sim: Any, x: float, z: float, d: float = 0.08) -> np.ndarray:
+    """Unit normal ``(3,)`` of the ground around ``(x, z)`` from three vertical rays ``d`` m apart."""
+    pts = np.array([[x, 50.0, z], [x + d, 50.0, z], [x, 50.0, z + d]])
+    ends = pts.copy()
+    ends[:, 1] = -50.0
+    hit = sim.ray(pts, ends)
+    if not np.isfinite(hit).all():
+        return np.array([0.0, 1.0, 0.0])
+    n = np.cross(hit[2] - hit[0], hit[1] - hit[0])
+    return n / max(float(np.linalg.norm(n)), 1e-12) * (1.0 if n[1] >= 0 else -1.0)
+
+
+def orient_feet(sim: Any, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """A standing pose ``q`` (``sim`` holding it) with each foot turned so that its sole lies in the
+    local terrain slope (003 §5.2: "the feet of the character are re-oriented to match the local
+    terrain slope"): the ankle rotation that tilts the foot's up axis onto the ground normal under it
+    (the smallest such turn); ``sim`` is left holding the new pose, not yet re-placed."""
+    from toolkit.motion import rotations as rot
+    from toolkit.motion.skeletons import HUMANOID
+
+    q = np.array(q, dtype=np.float64)
+    up = np.array([0.0, 1.0, 0.0])
+    for joint, link, parent in FEET:
+        pos, foot = sim.link_pose(link)
+        _, par = sim.link_pose(parent)
+        n = ground_normal(sim, float(pos[0]), float(pos[2]))
+        a = rot.quat_rotate(foot, up)  # the sole's normal now
+        axis = np.cross(a, n)
+        s, c = float(np.linalg.norm(axis)), float(a @ n)
+        if s < 1e-9:
+            continue
+        turn = rot.quat_from_axis_angle(axis / s, math.atan2(s, c))
+        local = rot.quat_multiply(rot.quat_conjugate(par), rot.quat_multiply(turn, foot))
+        sl = HUMANOID.q_slices[joint]
+        q[7 + sl.start:7 + sl.stop] = rot.quat_normalize(local)
+    sim.reset(q, np.asarray(qd, float))
+    return q

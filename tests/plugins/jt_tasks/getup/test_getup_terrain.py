@@ -137,3 +137,27 @@ def test_bad_terrain_input_is_one_line(override, match):
     with pytest.raises(JtError, match=match) as e:
         validate(compose(["task=getup", "action=raw", override]))
     assert "\n" not in str(e.value)
+
+
+def test_standing_starts_on_a_slope_get_their_feet_turned_to_it(world):
+    from jt_tasks.getup.initial import clip_pose
+    from toolkit.motion import rotations as rot
+
+    sim, spec = world
+    q, qd = clip_pose("getup_facedown", False, frame=-1)
+    xz = np.array([3 * spec.size - spec.size / 2 + 1.0, 2.0])  # the middle of a 30° face
+
+    def sole_angles() -> list[float]:
+        out = []
+        for _, link, _ in T.FEET:
+            pos, foot = sim.link_pose(link)
+            a = rot.quat_rotate(foot, np.array([0.0, 1.0, 0.0]))
+            out.append(math.degrees(math.acos(min(1.0, float(a @ T.ground_normal(sim, pos[0], pos[2]))))))
+        return out
+
+    q1 = T.place_on_ground(sim, q, qd, xz)
+    assert min(sole_angles()) > 10.0  # a flat-ground stance on 30°
+    q2 = T.orient_feet(sim, q1, qd)
+    T.place_on_ground(sim, q2, qd, xz)
+    assert max(sole_angles()) < 2.0  # 003 §5.2: feet re-oriented to the local slope
+    np.testing.assert_array_equal(q2[7:20], q1[7:20])  # only the ankles changed (chest .. right knee)
