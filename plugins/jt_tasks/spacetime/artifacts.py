@@ -4,12 +4,14 @@
 ``count`` ``(n_it, n_segments)``: eq 11's start-segment probabilities, the segments' running
 averages of the start targets, and eq 12's buffer sizes after each iteration, 002 §4.3) and
 ``start_sampling.png`` (the probabilities as an image: iteration down, segment across, and the
-last iteration's as bars).
+last iteration's as bars), and ``com_bounds.png``, the Fig. 5 analogue: the final rollout's CoM
+height against the clip phase with the reference and its ``com_y`` bounds.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -50,6 +52,46 @@ def plot_start_sampling(h: dict[str, np.ndarray], out: Path) -> Path:
     b2.plot(x, w[-1], "o-", color="C3", ms=3, label="w_k")
     b2.set_ylabel("w_k (start target)")
     b.legend(loc="upper left", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return Path(out)
+
+
+def com_height_data(env: Any, times: np.ndarray, com: np.ndarray, n_grid: int = 200) -> dict[str, np.ndarray]:
+    """What ``com_bounds.png`` draws, from a rollout of ``env`` (still open): ``phase`` and
+    ``com_y`` ``(n,)`` of the rollout's states, the reference's CoM height ``ref_phase`` /
+    ``ref_com_y`` ``(n_grid,)`` over one cycle and the channel's width ``width`` (inf: off)."""
+    ref = env.ref
+    times = np.asarray(times, dtype=float).reshape(-1)
+    phase = np.array([ref.phase(env.t0 + t) for t in times])
+    grid = np.linspace(0.0, 1.0, n_grid)
+    ref_y = np.array([ref.sample(g * ref.period).com[1] for g in grid])
+    width = float(env.widths[list(env.names).index("com_y")])
+    return {"phase": phase, "com_y": np.asarray(com, dtype=float).reshape(-1, 3)[:, 1], "ref_phase": grid,
+            "ref_com_y": ref_y, "width": np.array(width)}
+
+
+def plot_com_bounds(d: dict[str, np.ndarray], out: Path, title: str = "") -> Path:
+    """The Fig. 5 analogue (002): CoM height against phase, the reference (green), its bounds ±
+    width (red) and the rollout's states (blue dots)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3))
+    ax.plot(d["ref_phase"], d["ref_com_y"], color="green", lw=1.5, label="reference")
+    w = float(d["width"])
+    if np.isfinite(w):
+        for sgn in (-1, 1):
+            ax.plot(d["ref_phase"], d["ref_com_y"] + sgn * w, color="red", lw=1.0, label="bounds" if sgn > 0 else None)
+    ax.scatter(d["phase"], d["com_y"], s=6, color="C0", label="policy", zorder=3)
+    ax.set_xlabel("phase")
+    ax.set_ylabel("CoM height (m)")
+    ax.set_xlim(0, 1)
+    ax.set_title(title or "CoM height vs phase (002 Fig. 5)", fontsize=9)
+    ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     plt.close(fig)

@@ -249,8 +249,12 @@ class SpacetimeTask(PolicyTask):
         return {"phase": float(self.params.eval_phase), "evaluate": True}
 
     def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
+        from jt_tasks.spacetime.artifacts import com_height_data
+
         info = ro["info"]
-        data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))}}
+        ro["com_height"] = com_height_data(env, ro["time"], ro["com"])
+        data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))},
+                "phase": ro["com_height"]["phase"]}
         attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
                  "reason": str(info.get("reason", "")), "widths": str(list(spec.widths))}
         return data, attrs
@@ -275,6 +279,11 @@ class SpacetimeTask(PolicyTask):
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         history = {"mean_return": return_curve(trained),
                    "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
+        if "com_height" in ro:
+            from jt_tasks.spacetime.artifacts import plot_com_bounds
+
+            plot_com_bounds(ro["com_height"], Path(workdir) / "com_bounds.png",
+                            f"{Path(str(spec.clip)).stem}: CoM height vs phase, final rollout (002 Fig. 5)")
         hook = hooks.state.get("training")
         rows = hook.history() if hook is not None else np.zeros((0, 3))
         if len(rows):
@@ -296,4 +305,4 @@ class SpacetimeTask(PolicyTask):
         return Evaluation(metrics=metrics, history=history)
 
     def extra_artifacts(self, workdir: Path) -> list[str]:
-        return [n for n in ("start_sampling.h5", "start_sampling.png") if (Path(workdir) / n).exists()]
+        return [n for n in ("start_sampling.h5", "start_sampling.png", "com_bounds.png") if (Path(workdir) / n).exists()]

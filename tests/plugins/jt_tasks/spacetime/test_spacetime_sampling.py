@@ -168,7 +168,7 @@ def test_task_logs_the_is_distribution_per_iteration_seeded_and_resumable(tmp_pa
     import h5py
 
     ev = evaluate(tmp_path / "a")
-    assert {"start_sampling.h5", "start_sampling.png", "ppo.h5", "rollout.h5"} <= set(ev.artifacts)
+    assert {"start_sampling.h5", "start_sampling.png", "ppo.h5", "rollout.h5", "com_bounds.png"} <= set(ev.artifacts)
     with h5py.File(tmp_path / "a" / "start_sampling.h5") as f:
         probs, count = f["probs"][()], f["count"][()]
     assert probs.shape == (3, 10) and np.allclose(probs.sum(axis=1), 1.0) and count[-1].sum() > 0
