@@ -98,10 +98,13 @@ class LocalExecutor(Executor):
         """multiprocessing start method: spawn (safe with torch/pybullet), forkserver or fork."""
 
     def __init__(self, cfg: Any = None) -> None:
+        from toolkit.config import config_of
+
         super().__init__(cfg)
-        workers = int(getattr(cfg, "workers", 0) or 0) if cfg is not None else 0
+        params = config_of(self.Config, cfg, "executor=local")  # a dict, a group node or a Config
+        workers = int(params.workers or 0)
         self._workers = workers if workers > 0 else (os.cpu_count() or 1)
-        self._method = getattr(cfg, "start_method", "spawn") if cfg is not None else "spawn"
+        self._method = str(params.start_method)
         self._pool: Optional[Any] = None
 
     @property

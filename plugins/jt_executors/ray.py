@@ -148,7 +148,10 @@ class RayExecutor(Executor):
         except ImportError as e:  # a user mistake, reported as one line by the CLI
             raise JtError("executor=ray needs Ray: pip install -e '.[ray]'") from e
         self._ray = ray
-        get = (lambda k, d: getattr(cfg, k, d)) if cfg is not None else (lambda k, d: d)
+        from toolkit.config import config_of
+
+        params = config_of(self.Config, cfg, "executor=ray")  # a dict, a group node or a Config
+        get = lambda k, d: getattr(params, k, d)  # noqa: E731
         self._ship = str(get("ship_files", "auto"))
         if self._ship not in SHIP_MODES:
             raise JtError(f"executor.ship_files={self._ship}: choose one of {', '.join(SHIP_MODES)}")

@@ -9,6 +9,8 @@
 * ``toolkit.testing.curriculum.CurriculumContract``: set ``cls``, ``entry``, define ``stream(n)``.
 * ``toolkit.testing.simulator.SimulatorContract``: define ``make()``.
 * ``toolkit.testing.task.TaskContract``: set ``task``.
+* ``toolkit.testing.executor.ExecutorContract``: set ``executor_cls``, ``entry`` (or override the
+  ``executor`` fixture).
 
 The modules import ``pytest`` (jt's ``test`` extra: ``pip install jt[test]``); import them from
 test modules only. None imports a built-in plugin at module level. See docs/writing-a-plugin.md.

@@ -1,19 +1,16 @@
-"""executor=local: the process pool (and the in-process path for workers=1)."""
+"""executor=local: the process pool (and the in-process path for workers=1), through the shipped
+contract suite (``toolkit.testing.executor``), as a third-party executor's tests use it."""
 
 import os
 
 import pytest
 
 from jt_executors.local import LocalExecutor
-from tests.plugins.jt_executors.executor_contract import Counter, ExecutorContract
+from toolkit.testing.executor import Counter, ExecutorContract
 
 
 class TestLocalPool(ExecutorContract):
-    @pytest.fixture(scope="class")
-    def executor(self):
-        ex = LocalExecutor(LocalExecutor.Config(workers=2))
-        yield ex
-        ex.close()
+    executor_cls, entry, cfg = LocalExecutor, "local", {"name": "local", "workers": 2}
 
     def test_actors_live_in_other_processes(self, executor):
         group = executor.actors(Counter, [(0,), (0,)])
@@ -25,6 +22,22 @@ class TestLocalPool(ExecutorContract):
 
 
 class TestLocalInline(ExecutorContract):
-    @pytest.fixture(scope="class")
-    def executor(self):
-        return LocalExecutor(LocalExecutor.Config(workers=1))
+    executor_cls, entry, cfg = LocalExecutor, "local", {"name": "local", "workers": 1}
+
+    def test_everything_runs_in_this_process(self, executor):
+        group = executor.actors(Counter, [(0,)])
+        try:
+            assert group.call("pid") == [os.getpid()]
+        finally:
+            group.close()
+        assert executor.n_workers == 1
+
+
+def test_workers_zero_means_one_per_core():
+    assert LocalExecutor({"name": "local"}).n_workers == (os.cpu_count() or 1)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_typed_config_instance_works_too(workers):
+    with LocalExecutor(LocalExecutor.Config(workers=workers)) as ex:
+        assert ex.n_workers == workers and ex.map(abs, [-1, -2, -3]) == [1, 2, 3]

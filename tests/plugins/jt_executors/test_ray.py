@@ -5,12 +5,14 @@ Ray is an optional extra (``pip install -e '.[ray]'``) and slow to start, so thi
 
 import pytest
 
-from tests.plugins.jt_executors.executor_contract import ExecutorContract
+from toolkit.testing.executor import ExecutorContract
 
 pytestmark = pytest.mark.slow
 
 
 class TestRay(ExecutorContract):
+    entry = "ray"
+
     @pytest.fixture(scope="class")
     def executor(self):
         ray = pytest.importorskip("ray")

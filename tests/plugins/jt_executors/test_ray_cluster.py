@@ -17,7 +17,7 @@ import time
 
 import pytest
 
-from tests.plugins.jt_executors.executor_contract import Counter, ExecutorContract
+from toolkit.testing.executor import Counter, ExecutorContract
 from tests.plugins.jt_executors.ray_cluster import DRIVER_ENV, LocalRayCluster, node_of
 from toolkit.config import compose
 from toolkit.errors import JtError
