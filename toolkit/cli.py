@@ -84,7 +84,7 @@ def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untype
     if others:
         raise JtError(f"resume= continues a run with its own config; drop: {' '.join(others)}")
     stores = [o.split("=", 1)[1] for o in overrides if o.startswith("store=")]
-    store = Store(store_root(stores[0] if stores else None))
+    store = Store(store_root(stores[0] if stores else None), must_exist=True)
     store.get_run(run_id)  # one clear line if the id is unknown
     path = store.workdir(run_id) / "config.yaml"
     if not path.is_file() and store.is_server:  # a server store, resumed on another machine
@@ -187,6 +187,18 @@ def _store_arg(overrides: Optional[List[str]]) -> Optional[str]:
     return store
 
 
+def _usage_line(e: Exception) -> str:
+    """A command-line mistake in one line, with the valid commands when one was unknown."""
+    msg = " ".join(str(e.format_message()).split())  # type: ignore[attr-defined]
+    ctx = getattr(e, "ctx", None)
+    command = getattr(ctx, "command", None)
+    if msg.startswith("No such command") and command is not None and hasattr(command, "list_commands"):
+        msg += f" Valid: {', '.join(command.list_commands(ctx))}."
+    if ctx is not None and getattr(ctx, "command_path", ""):
+        msg += f" (see: {ctx.command_path} --help)"
+    return msg
+
+
 def main() -> None:
     """Console entry point: one line for user mistakes, exit status 2."""
     debug = "--debug" in sys.argv
@@ -197,18 +209,17 @@ def main() -> None:
                 typer.echo("jt: interrupted", err=True)
             sys.exit(rc)
     except Exception as e:  # noqa: BLE001
-        import click
-
         from toolkit.errors import JtError
 
         if debug:
             raise
-        if isinstance(e, click.exceptions.Exit):
-            sys.exit(e.exit_code)
-        if isinstance(e, click.ClickException):
-            typer.echo(f"jt: {e.format_message()}", err=True)
+        kinds = {c.__name__ for c in type(e).__mro__}  # click's classes, or typer's vendored copies
+        if "Exit" in kinds:
+            sys.exit(getattr(e, "exit_code", 0))
+        if "ClickException" in kinds:
+            typer.echo(f"jt: {_usage_line(e)}", err=True)
             sys.exit(2)
-        if isinstance(e, click.exceptions.Abort):
+        if "Abort" in kinds:
             typer.echo("jt: aborted", err=True)
             sys.exit(130)
         if isinstance(e, JtError):

@@ -52,3 +52,30 @@ def test_run_show_and_bad_run_id(example_plugin_dir, tmp_path):
     assert s.returncode == 0 and "[FINISHED]" in s.stdout and "evaluation.h5" in s.stdout
     bad = run_jt("show", "deadbeef", f"store={store}")
     assert bad.returncode == 2 and bad.stderr.startswith("jt: no run 'deadbeef'")
+
+
+def _one_line(p, code=2):
+    assert p.returncode == code, p.stderr[-300:]
+    assert len(p.stderr.strip().splitlines()) == 1 and "Traceback" not in p.stderr and "internal error" not in p.stderr
+    return p.stderr.strip()
+
+
+def test_command_line_mistakes_are_one_line_with_the_valid_choices():
+    assert "Valid: spd, ppo, rollout" in _one_line(run_jt("bench", "nope"))
+    assert "Valid: run, compare" in _one_line(run_jt("nope"))
+    assert "--seeds" in _one_line(run_jt("compare", "task=zdt1", "--seeds", "abc"))
+
+
+def test_bad_stores_are_one_line_and_never_created(tmp_path):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    assert "is a file, not a folder" in _one_line(run_jt("run", "task=zdt1", "experiment=smoke", f"store={afile}"))
+    (tmp_path / "corrupt").mkdir()
+    (tmp_path / "corrupt" / "mlflow.db").write_bytes(b"not a database at all, not even close")
+    msg = _one_line(run_jt("run", "task=zdt1", "experiment=smoke", f"store={tmp_path / 'corrupt'}"))
+    assert "not an SQLite database" in msg
+    assert not (tmp_path / "corrupt" / "runs").exists()
+    missing = tmp_path / "nowhere"
+    assert "no jt store at" in _one_line(run_jt("show", "deadbeef", f"store={missing}"))
+    assert "no jt store at" in _one_line(run_jt("run", "resume=deadbeef", f"store={missing}"))
+    assert not missing.exists()  # reading commands never create a store

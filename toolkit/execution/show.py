@@ -17,7 +17,7 @@ def show(run_id: str, store_path: Optional[str] = None, artifact: Optional[str] 
     """Text description of run ``run_id`` in the store (or of its artifact ``artifact``)."""
     from toolkit.store.tracking import Store, store_root
 
-    store = Store(store_root(store_path))
+    store = Store(store_root(store_path), must_exist=True)  # reading never creates a store
     run = store.get_run(run_id)
     art = store.artifact_dir(run_id)
     if artifact is not None:

@@ -78,7 +78,7 @@ class ServerStore(Store):
 
     is_server = True
 
-    def __init__(self, root: str | os.PathLike) -> None:  # noqa: D107 - documented on the class
+    def __init__(self, root: str | os.PathLike, must_exist: bool = False) -> None:  # noqa: D107 - documented on the class
         uri = str(root).rstrip("/")
         if not is_server_uri(uri):
             raise JtError(f"store={root}: not an http(s):// MLflow server URI")

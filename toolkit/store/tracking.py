@@ -46,6 +46,32 @@ def quiet_mlflow_logs() -> None:
         logging.getLogger(name).setLevel(logging.WARNING)
 
 
+SQLITE_MAGIC = b"SQLite format 3\x00"
+"""The first 16 bytes of every SQLite database file."""
+
+
+def check_root(root: Path, must_exist: bool = False) -> None:
+    """One ``JtError`` line when ``root`` cannot be a store: a file, a folder whose ``mlflow.db`` is
+    not SQLite (corrupt, truncated, another file), or (``must_exist``) no store at all.
+
+    Args:
+        root: the store folder.
+        must_exist: refuse a folder without ``mlflow.db`` (reading commands never create a store).
+    """
+    if root.exists() and not root.is_dir():
+        raise JtError(f"store={root} is a file, not a folder; give a folder (created if missing) "
+                      "or an MLflow server URI http://host:port")
+    db = root / "mlflow.db"
+    if must_exist and not db.is_file():
+        raise JtError(f"no jt store at {root} (no mlflow.db); jt run ... store={root} makes one")
+    if db.is_file() and db.stat().st_size > 0:
+        with open(db, "rb") as fh:
+            head = fh.read(len(SQLITE_MAGIC))
+        if head != SQLITE_MAGIC:
+            raise JtError(f"store={root}: its mlflow.db is not an SQLite database (corrupt, or another "
+                          "file); move it away to start a new store there, or give another store=")
+
+
 @contextmanager
 def _locked(root: Path) -> Iterator[None]:
     root.mkdir(parents=True, exist_ok=True)
@@ -76,17 +102,29 @@ class Store:
             return super().__new__(ServerStore)
         return super().__new__(cls)
 
-    def __init__(self, root: str | os.PathLike) -> None:
+    def __init__(self, root: str | os.PathLike, must_exist: bool = False) -> None:
         self.root = Path(root).resolve()
         self.uri = f"sqlite:///{self.root / 'mlflow.db'}"
+        check_root(self.root, must_exist)
         from mlflow.tracking import MlflowClient
 
         quiet_mlflow_logs()
 
-        with _locked(self.root):
-            self.client = MlflowClient(tracking_uri=self.uri)
-            self.client.search_experiments(max_results=1)  # creates/migrates the schema under the lock
-            self._default_inside()
+        try:
+            with _locked(self.root):
+                self.client = MlflowClient(tracking_uri=self.uri)
+                self.client.search_experiments(max_results=1)  # creates/migrates the schema under the lock
+                self._default_inside()
+        except OSError as e:
+            raise JtError(f"store={self.root}: cannot write there ({e.strerror or e}); "
+                          "give a folder you can write to, or an MLflow server URI http://host:port") from e
+        except Exception as e:  # noqa: BLE001 - MLflow / SQLAlchemy raise many types for a bad database
+            if "sqlite" in type(e).__module__.lower() or "sqlalchemy" in type(e).__module__.lower() \
+                    or "MlflowException" in type(e).__name__:
+                raise JtError(f"store={self.root}: its mlflow.db is not a usable MLflow database "
+                              f"({str(e).splitlines()[0][:120]}); move it away to start a new store "
+                              "there, or give another store=") from e
+            raise
 
     def _default_inside(self) -> None:
         """Point MLflow's "Default" experiment (id 0) into the store: MLflow creates it with the
