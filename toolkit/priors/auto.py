@@ -3,7 +3,8 @@
 A P-VAE / C-VAE action space needs a trained prior (``000`` §4.2, ``003`` §3.5). With
 ``action.prior=auto`` (the default), ``jt run`` looks in the run's store for the prior it trained
 earlier with the default settings (tag ``jt.auto_prior``), and trains one if there is none:
-``jt run task=pose_prior action=<kind>`` in the same store, about a minute on 2 cores. The run's
+``jt run task=pose_prior action=<kind>`` in the same store, about a minute on 2 cores (a run with
+``experiment=smoke`` gets its own smoke-sized prior, ``experiment=smoke`` of ``task=pose_prior``). The run's
 saved config then names that prior run, so a resumed or repeated run uses the same prior.
 """
 
@@ -30,13 +31,15 @@ def wants_auto(cfg: Any) -> str:
     return ""
 
 
-def find(store: Any, kind: str) -> str:
-    """Id of the newest finished auto prior run of ``kind`` in ``store`` whose ``prior.h5`` is there, or ``""``."""
+def find(store: Any, tag: str) -> str:
+    """Id of the newest finished auto prior run tagged ``tag`` (``pvae``, ``cvae``, ``pvae@smoke``
+    ...) in ``store`` whose ``prior.h5`` is there, or ``""``."""
+    kind = tag.split("@")[0]
     exp = store.client.get_experiment_by_name("pose_prior")
     if exp is None:
         return ""
     runs = store.client.search_runs(
-        [exp.experiment_id], filter_string=f"tags.`{TAG}` = '{kind}' and attributes.status = 'FINISHED'",
+        [exp.experiment_id], filter_string=f"tags.`{TAG}` = '{tag}' and attributes.status = 'FINISHED'",
         order_by=["attributes.start_time DESC"], max_results=20)
     from toolkit.priors.io import load_prior
 
@@ -62,16 +65,18 @@ def resolve(cfg: Any, train_overrides: Sequence[str] = ()) -> Any:
     from toolkit.store.tracking import Store, store_root
 
     store = Store(store_root(str(cfg.store)))
-    run_id = find(store, kind)
+    smoke = str(cfg.get("profile", "default")) == "smoke"  # a smoke run gets a smoke-sized prior
+    tag = f"{kind}@smoke" if smoke else kind
+    run_id = find(store, tag)
     if run_id:
         print(f"jt: action.prior=auto: the store's {kind} prior, run {run_id}", file=sys.stderr, flush=True)
     else:
-        run_id = train(store, kind, train_overrides)
+        run_id = train(store, kind, [*(["experiment=smoke"] if smoke else []), *train_overrides], tag)
     cfg.action.prior = run_id
     return cfg
 
 
-def train(store: Any, kind: str, overrides: Sequence[str] = ()) -> str:
+def train(store: Any, kind: str, overrides: Sequence[str] = (), tag: str = "") -> str:
     """Train the default ``kind`` prior into ``store`` (``jt run task=pose_prior action=<kind>``); its run id."""
     from toolkit.config import compose
     from toolkit.execution.runner import run
@@ -81,5 +86,5 @@ def train(store: Any, kind: str, overrides: Sequence[str] = ()) -> str:
           file=sys.stderr, flush=True)
     conf = compose(["task=pose_prior", f"action={kind}", f"store={store.root}", *overrides])
     res = run(conf)
-    store.set_tags(res.run_id, {TAG: kind})
+    store.set_tags(res.run_id, {TAG: tag or kind})
     return res.run_id

@@ -20,15 +20,17 @@ def test_auto_trains_once_then_reuses(tmp_path):
 
     cfg = _cfg(tmp_path)
     assert str(cfg.action.prior) == "auto" and auto.wants_auto(cfg) == "pvae"
-    first = auto.resolve(cfg, train_overrides=["experiment=smoke"])
+    first = auto.resolve(cfg)  # a smoke run trains a smoke-sized prior
     run_id = str(first.action.prior)
     assert run_id != "auto" and load_prior(run_id, str(tmp_path), kind="pvae").latent_dim > 0
     store = Store(tmp_path)
-    assert store.get_run(run_id).data.tags[auto.TAG] == "pvae"
-    again = auto.resolve(_cfg(tmp_path), train_overrides=["experiment=smoke"])
+    assert store.get_run(run_id).data.tags[auto.TAG] == "pvae@smoke"
+    assert store.get_run(run_id).data.params["task.epochs"] == "3"  # experiment=smoke of task=pose_prior
+    again = auto.resolve(_cfg(tmp_path))
     assert str(again.action.prior) == run_id  # reused, not trained again
     exp = store.client.get_experiment_by_name("pose_prior")
     assert len(store.client.search_runs([exp.experiment_id])) == 1
+    assert auto.find(store, "pvae") == ""  # a smoke prior is never taken for a full-size run
 
 
 def test_explicit_priors_and_raw_actions_are_left_alone(tmp_path):
