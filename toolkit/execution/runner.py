@@ -110,13 +110,20 @@ def _open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: A
     return run_id, False
 
 
-def _close_stale_children(store: Store, run_id: str, experiment: str) -> None:
+def _close_stale_children(store: Store, run_id: str, experiment: str, recorded: set[int]) -> None:
+    """Evaluations the interruption cut off (still RUNNING, or FINISHED but not yet in the saved
+    history): KILLED and renamed ``eval-NNNN·interrupted``, so the re-evaluation that follows is the
+    one ``eval-NNNN`` and no two runs share a name."""
     runs = store.client.search_runs(
         [store.experiment_id(experiment)],
-        filter_string=f"tags.mlflow.parentRunId = '{run_id}' and attributes.status = 'RUNNING'",
+        filter_string=f"tags.mlflow.parentRunId = '{run_id}' and attributes.status != 'KILLED'",
     )
     for r in runs:
-        store.end_run(r.info.run_id, "KILLED", "interrupted; re-evaluated when the parent resumed")
+        idx = r.data.tags.get("jt.eval_index")
+        unsaved = r.info.status == "FINISHED" and idx is not None and int(idx) not in recorded
+        if r.info.status == "RUNNING" or unsaved:
+            store.set_tags(r.info.run_id, {"mlflow.runName": f"{r.info.run_name}·interrupted"})
+            store.end_run(r.info.run_id, "KILLED", "interrupted; re-evaluated when the parent resumed")
 
 
 def run(cfg: Any, command: Optional[str] = None) -> RunResult:
@@ -152,9 +159,9 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
         _log(f"jt: cost: {cfg.cost}")
     try:
         with _Terminate():
-            if resumed:
-                _close_stale_children(store, run_id, experiment)
             history = History.load(hist_path, names)
+            if resumed:
+                _close_stale_children(store, run_id, experiment, {r.index for r in history.records})
             searcher = search_cls(problem, cfg.search, int(cfg.seed))
             _replay(searcher, history, int(searcher.batch_size))
             if resumed and len(history):

@@ -109,6 +109,11 @@ def test_killed_run_resumes_from_last_completed_evaluation(example_plugin, examp
                                         filter_string=f"tags.mlflow.parentRunId = '{rid}'")
     statuses = sorted(c.info.status for c in children)
     assert statuses.count("FINISHED") == 6 and set(statuses) <= {"FINISHED", "KILLED"}
+    names = [c.info.run_name for c in children]
+    assert sorted(c.info.run_name for c in children if c.info.status == "FINISHED") == \
+        [f"eval-{i:04d}" for i in range(6)]
+    assert len(set(names)) == len(names)  # a cut-off evaluation is eval-NNNN·interrupted, KILLED
+    assert all(n.endswith("·interrupted") for c, n in zip(children, names) if c.info.status == "KILLED")
     assert store.get_run(rid).info.status == "FINISHED"
 
 
