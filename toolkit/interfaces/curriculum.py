@@ -14,7 +14,8 @@ class Curriculum(Plugin, abc.ABC):
     Required: ``update``, ``state``, ``load_state``. What the policy tasks call, with defaults:
     ``bind(extra)`` (keep the state in the trainer's checkpointed dict), ``on_iteration(...)``
     (the PPO trainer's per-iteration hook: episodes to ``update``, state back into ``extra``,
-    returns ``env_attrs()``) and ``env_attrs()`` (none). ``jt_curricula.base.IterationCurriculum``
+    returns ``env_attrs()``), ``env_attrs()`` (none) and ``frozen()`` (never: when training may
+stop early). ``jt_curricula.base.IterationCurriculum``
     is the fuller base the built-ins use.
 
     Attributes:
@@ -44,6 +45,11 @@ class Curriculum(Plugin, abc.ABC):
     def env_attrs(self) -> dict[str, Any]:
         """Attributes to set on every environment for the current difficulty (none by default)."""
         return {}
+
+    def frozen(self) -> bool:
+        """True once training should stop at the reached difficulty (the jumps stop at
+        ``z_freeze``, ``000`` §6.1.4); never by default."""
+        return False
 
     def end_iteration(self, iteration: int, samples: int, stats: Any) -> None:
         """Account for one finished training iteration, after its episodes went to ``update``

@@ -251,7 +251,9 @@ class JumpTask(PolicyTask):
         cur = hooks.state["cur"]
         for k, v in cur.env_attrs().items():  # the reached difficulty
             setattr(env, k, v)
-        self._fallback = (float(cur.params.z_min), float(cur.params.dz), hooks.state["z_attr"])
+        p = getattr(cur, "params", None)  # z_min / dz of a bar_height-like curriculum; others: no fallback
+        z_min, dz = getattr(p, "z_min", None), getattr(p, "dz", None)
+        self._fallback = (float(z_min), float(dz), hooks.state["z_attr"]) if z_min is not None and dz else None
 
     def retry_rollout(self, env: Any, ro: dict) -> bool:
         """``task.final_fallback``: one Δz lower when the jump never crossed the plane (not below z_min)."""
@@ -281,11 +283,12 @@ class JumpTask(PolicyTask):
         from jt_tasks.policy.train import last_finite, return_curve
 
         res, init = trained.result, self.stage2_init()
+        trained_z = float(hooks.state["cur"].env_attrs().get(hooks.state["z_attr"], math.nan))  # the curriculum's z
         succ = [r for _, _, r in hooks.state["z_hist"] if math.isfinite(r)]
         angle = float(ro["feature_angle"])
         metrics = {
-            "strategy_angle": angle, "bar_height_reached": float(ro.get("final_z", hooks.state["cur"].z)),
-            "bar_height_trained": float(hooks.state["cur"].z),
+            "strategy_angle": angle, "bar_height_reached": float(ro.get("final_z", trained_z)),
+            "bar_height_trained": trained_z,
             "mean_return": float(ro["return"]),
             "train_mean_return": last_finite(res.history.get("mean_return", [])),
             "success_rate": succ[-1] if succ else 0.0,
