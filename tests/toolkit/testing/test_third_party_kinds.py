@@ -120,8 +120,6 @@ def test_the_action_space_runs_a_policy_task_by_config_alone(tp_site, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="jt_tasks.jumping.train reads Curriculum.frozen and .z, which the "
-                   "Curriculum interface does not declare")
 def test_the_curriculum_runs_a_jump_by_config_alone(tp_site, tmp_path):
     _run(tp_site, tmp_path / "store", "task=highjump", "curriculum=tp_curriculum", "experiment=smoke",
          "search.budget=1")
