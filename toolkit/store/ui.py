@@ -38,6 +38,9 @@ def serve(root: Path, port: int) -> int:
     Returns:
         The server's exit status (0 after Ctrl-C / SIGTERM).
     """
+    from toolkit.store.tracking import check_root
+
+    check_root(root)  # a file, or an mlflow.db that is not SQLite: one line, before MLflow's traceback
     if not (root / "mlflow.db").is_file():
         from toolkit.store.tracking import Store
 

@@ -65,3 +65,14 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_a_bad_store_is_one_line_before_mlflow_starts(tmp_path):
+    import pytest
+
+    from toolkit.errors import JtError
+    from toolkit.store.ui import serve
+
+    (tmp_path / "mlflow.db").write_bytes(b"not a database")
+    with pytest.raises(JtError, match="not an SQLite database"):
+        serve(tmp_path, free_port())
