@@ -84,6 +84,8 @@ class SPDTrackingTask(Task):
 
     Config: ClassVar[type] = SPDTrackingConfig
     timing_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "step_us", "spd_us")
+    curve_prefix: ClassVar[str] = "tracking/"
+    """Its curves are tracking error over simulation steps, not training curves."""
     key_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "err_mean_dt30",
                                               "err_mean_dt600", "n_diverged")
 

@@ -80,7 +80,7 @@ def test_stage2_trains_with_the_novelty_reward(stage1):
     m = store.get_run(res.run_id).data.metrics
     assert m["samples"] == 64 and m["novelty_set_size"] >= 1
     assert math.isfinite(m["mean_return"])  # an uncrossed episode no longer makes the reward NaN
-    nov = store.client.get_metric_history(res.run_id, "novelty")  # per-iteration mean r_novelty
+    nov = store.client.get_metric_history(res.run_id, "train/novelty")  # per-iteration mean r_novelty
     assert nov and all(0.01 <= h.value <= 1.0 for h in nov)
     if "feature_q0" in m:  # the final jump crossed: its novelty vs Π is a metric
         assert 0.01 <= m["novelty"] <= 1.0
