@@ -67,9 +67,18 @@ def after_training(hooks: Hooks, result: Any) -> None:
 
 def jump_curves(hooks: Hooks, result: Any) -> dict[str, list]:
     """``z`` (bar height / obstacle width), success rate and (Stage 2) novelty against samples."""
+    from jt_tasks.policy.train import TIMES
+
     z_attr, z_hist = hooks.state["z_attr"], hooks.state["z_hist"]
-    out = {z_attr: [(int(s), z) for s, z, _ in z_hist],
-           "success_rate": [(int(s), r) for s, _, r in z_hist if math.isfinite(r)]}
+    times = [float(t) for t in np.asarray(result.extra.get(TIMES, np.zeros(0)), dtype=np.float64).ravel()]
+    if len(times) != len(z_hist):  # a checkpoint from before the times were kept
+        times = [None] * len(z_hist)
+
+    def point(s: float, v: float, t: Optional[float]) -> tuple:
+        return (int(s), v, t) if t is not None else (int(s), v)
+
+    out = {z_attr: [point(s, z, t) for (s, z, _), t in zip(z_hist, times)],
+           "success_rate": [point(s, r, t) for (s, _, r), t in zip(z_hist, times) if math.isfinite(r)]}
     nov = np.asarray(result.extra.get("novelty_history", np.zeros((0, 2))), dtype=np.float64).reshape(-1, 2)
     if len(nov):
         out["novelty"] = [(int(s), float(v)) for s, v in nov]

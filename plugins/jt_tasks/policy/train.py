@@ -104,9 +104,17 @@ def train_policy(env_fn: Callable[[int], Any], agent: Any, executor: Any, workdi
     if cfg.n_workers > 1 and executor is not None:
         pool = plugins.load("executor", str(executor.name))(executor)
     path = Path(workdir) / CHECKPOINT
+    extra = {} if extra is None else extra
+
+    def timed(it: int, samples: int, stats: Any) -> Any:  # each iteration's wall-clock time, checkpointed
+        out = on_iteration(it, samples, stats) if on_iteration is not None else None
+        prev = np.asarray(extra.get(TIMES, np.zeros(0)), dtype=np.float64).ravel()
+        extra[TIMES] = np.append(prev, time.time())
+        return out
+
     t0 = time.perf_counter()
     try:
-        result = ppo.train(env_fn, cfg, pool, path, resume=True, on_iteration=on_iteration, extra=extra,
+        result = ppo.train(env_fn, cfg, pool, path, resume=True, on_iteration=timed, extra=extra,
                            should_stop=should_stop, warm_start=warm_start)
     finally:
         if pool is not None:
@@ -161,6 +169,10 @@ def pick_frames(frames: list, n: int) -> list:
     return [frames[i] for i in idx]
 
 
+TIMES = "iteration_time"
+"""Key of the per-iteration wall-clock times in PPO's checkpointed ``extra``."""
+
+
 def save_motion(workdir: Path, frames: list, n_filmstrip: int, fps: float = 30.0) -> list[str]:
     """``filmstrip.png`` (``n_filmstrip`` frames side by side) and ``motion.gif`` (all frames at
     ``fps``, enlarged to at least 320 px wide unless smoke-sized: ``toolkit.render.enlarge``) in
@@ -187,10 +199,19 @@ def samples_axis(trained: Trained) -> list[int]:
     return [per_it * (i + 1) for i in range(n_it)]
 
 
-def return_curve(trained: Trained) -> list[tuple[int, float]]:
-    """``[(samples, mean episode return)]`` per iteration, iterations with no episode left out."""
+def iteration_times(trained: Trained) -> list[float]:
+    """Unix time at the end of each iteration ``(n_iterations,)`` (``extra`` of ``ppo.h5``; an
+    older checkpoint without them: empty)."""
+    return [float(t) for t in np.asarray(trained.result.extra.get(TIMES, np.zeros(0)), dtype=np.float64).ravel()]
+
+
+def return_curve(trained: Trained) -> list[tuple]:
+    """``[(samples, mean episode return, unix time)]`` per iteration, iterations with no episode
+    left out (the time is missing for a checkpoint written before it was recorded)."""
     values = trained.result.history.get("mean_return", [])
-    return [(s, float(v)) for s, v in zip(samples_axis(trained), values) if math.isfinite(v)]
+    times = iteration_times(trained)
+    rows = list(zip(samples_axis(trained), values, times if len(times) == len(values) else [None] * len(values)))
+    return [(s, float(v), t) if t is not None else (s, float(v)) for s, v, t in rows if math.isfinite(v)]
 
 
 def last_finite(values: list) -> float:

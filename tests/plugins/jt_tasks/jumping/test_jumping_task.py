@@ -54,7 +54,9 @@ def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
 
     c = curves.read(tmp_path / "ppo.h5")
     assert len(c["samples"]) == ev.metrics["iterations"] and c["samples"][-1] == ev.metrics["samples"]
-    assert list(c["bar_height"]) == [v for _, v in ev.history["bar_height"]]
+    assert list(c["bar_height"]) == [p[1] for p in ev.history["bar_height"]]
+    times = [p[2] for p in ev.history["bar_height"]]  # each iteration with its own wall-clock time
+    assert len(set(times)) == len(times) and times == sorted(times)
     assert curves.plot([c], ["tiny"], tmp_path / "curves.png").stat().st_size > 1000
     assert curves.table([c], ["tiny"]).count("| tiny |") == len(c["samples"])
 
