@@ -80,6 +80,20 @@ def filmstrip(point: dict[str, float], path: Path, title: str, settings=None, wi
     return _save(fig, path)
 
 
+def animation(point: dict[str, float], path: Path, settings=None, width: int = 160, height: int = 240,
+              fps: float = 30.0) -> Path:
+    """Simulate ``point`` and save the whole jump, one frame every ``1/fps`` s, as a GIF (at least
+    320 px wide, ``toolkit.render.save_animation``) to ``path``."""
+    from jt_tasks.standing_jump.simulate import simulate
+    from toolkit.render import save_animation
+
+    res = simulate(point, settings, record=True, record_every=1.0 / fps)
+    kw = {} if settings is None else {"mass": settings.mass, "body_height": settings.height,
+                                      "sim": settings.sim}
+    images = render_poses([q for _, q in res.snapshots], BROWN if res.natural else BLUE, width, height, **kw)
+    return save_animation(images, path, fps=fps)
+
+
 def front_plot(height: np.ndarray, effort: np.ndarray, front: np.ndarray, natural: np.ndarray,
                failed: np.ndarray, path: Path, natural_max: Optional[float] = None) -> Path:
     """``004`` Fig. 8 analogue: effort objective vs jump height for every sample, front joined.

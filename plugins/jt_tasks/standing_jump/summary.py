@@ -67,7 +67,7 @@ def summarize(task: Any, evaluations: Sequence[Evaluation], workdir: Path) -> di
     """Write ``front.h5``, ``front.png`` and filmstrips to ``workdir``; return run metrics."""
     from jt_tasks.standing_jump import params as P
     from jt_tasks.standing_jump.objectives import hypervolume
-    from jt_tasks.standing_jump.render import filmstrip, front_plot
+    from jt_tasks.standing_jump.render import animation, filmstrip, front_plot
     from toolkit.store import h5
 
     evs = list(evaluations)
@@ -122,4 +122,6 @@ def summarize(task: Any, evaluations: Sequence[Evaluation], workdir: Path) -> di
             if evs[i].point:
                 filmstrip(evs[i].point, workdir / f"filmstrip_{label}.png", f"{label.replace('_', ' ')} (sample {i})",
                           settings, task.params.filmstrip_width, task.params.filmstrip_height)
+                animation(evs[i].point, workdir / f"jump_{label}.gif", settings,  # the same jump, moving
+                          task.params.filmstrip_width, task.params.filmstrip_height)
     return out

@@ -127,6 +127,10 @@ def test_summarize_writes_the_front_table_and_pictures(runs, task, tmp_path):
     assert (tmp_path / "front.png").stat().st_size > 1000
     assert (tmp_path / "filmstrip_lowest_natural.png").stat().st_size > 1000
     assert (tmp_path / "filmstrip_highest_natural.png").exists()
+    import imageio.v3 as iio
+
+    gif = iio.imread(tmp_path / "jump_lowest_natural.gif")  # the same jump, moving (default 160 px: shown at 320)
+    assert gif.ndim == 4 and gif.shape[0] > 5 and gif.shape[2] == 48  # test-sized frames (< 96 px) stay as rendered
     if runs["assist"].metrics["success"]:
         assert (tmp_path / "filmstrip_highest_supernatural.png").exists()
 
