@@ -58,7 +58,7 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
         t0 = time.monotonic()
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)
-        assert time.monotonic() - t0 < 10  # stopped, not waited out and killed
+        assert time.monotonic() - t0 < 15  # stopped by SIGTERM, not by the SIGKILL that follows after 15 s
         time.sleep(1)
         assert not [k for k in kids if os.path.exists(f"/proc/{k[0]}")], "the server outlived jt ui"
     finally:
