@@ -155,7 +155,7 @@ def test_interrupted_run_resumes_through_the_server(server, example_plugin_dir, 
     from tests.conftest import jt_env
 
     monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
-    args = ["task=quadratic", "task.sleep=1.0", "search=random", "search.budget=5", "executor.workers=1",
+    args = ["task=quadratic", "task.sleep=2.0", "search=random", "search.budget=5", "executor.workers=1",
             f"store={server.uri}", "seed=1"]
     proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", *args], env=jt_env(example_plugin_dir),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
