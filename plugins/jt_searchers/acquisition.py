@@ -1,8 +1,12 @@
-"""BDS acquisition functions (``000`` §5.1): exploration sigma(x) (eq 9) and expected diversity (eq 7)."""
+"""BDS acquisition functions (``000`` §5.1): exploration sigma(x) (eq 9) and expected diversity (eq 7).
+
+Either may be weighted by the probability that a point yields a feature at all
+(``jt_searchers.feasibility``; ours, beyond the paper), once a told point has failed.
+"""
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -17,18 +21,25 @@ class Exploration:
 
     Args:
         gp: the (possibly fantasised) surrogate.
+        feasible: ``p(x)`` model (``Feasibility``) multiplying sigma, or ``None``.
     """
 
-    def __init__(self, gp: FeatureGP) -> None:
+    def __init__(self, gp: FeatureGP, feasible: Optional[Any] = None) -> None:
         self.gp = gp
+        self.feasible = feasible
 
     def __call__(self, U: np.ndarray) -> np.ndarray:
         """Values at unit points ``U`` ``(n, dim)`` → ``(n,)``."""
-        return self.gp.predict_standardised(U)[1]
+        std = self.gp.predict_standardised(U)[1]
+        return std if self.feasible is None else std * self.feasible(U)
 
     def value_and_grad(self, u: np.ndarray) -> tuple[float, np.ndarray]:
         """Value and gradient at one unit point ``u`` ``(dim,)`` (for L-BFGS-B)."""
-        return self.gp.std_and_grad(u)
+        std, dstd = self.gp.std_and_grad(u)
+        if self.feasible is None:
+            return std, dstd
+        p, dp = self.feasible.value_and_grad(u)
+        return std * p, dstd * p + std * dp
 
 
 class ExpectedDiversity:
@@ -43,10 +54,13 @@ class ExpectedDiversity:
         observed: features already observed ``(t, m)``, raw units (fantasised ones included in a batch).
         distance: vectorised feature distance (``distances``).
         z: standard-normal draws ``(n_mc, m)``.
+        feasible: ``p(x)`` model (``Feasibility``) multiplying the estimate, or ``None``.
     """
 
-    def __init__(self, gp: FeatureGP, observed: np.ndarray, distance: Distance, z: np.ndarray) -> None:
+    def __init__(self, gp: FeatureGP, observed: np.ndarray, distance: Distance, z: np.ndarray,
+                 feasible: Optional[Any] = None) -> None:
         self.gp = gp
+        self.feasible = feasible
         self.observed = np.asarray(observed, dtype=float).reshape(-1, len(gp.centre))
         self.distance = distance
         self.z = np.asarray(z, dtype=float)
@@ -61,7 +75,7 @@ class ExpectedDiversity:
         for i in range(len(U)):
             samples = mean[i] + std[i] * self.z  # (n_mc, m)
             out[i] = np.mean(np.min(pairwise(self.distance, samples, self.observed), axis=1))
-        return out
+        return out if self.feasible is None else out * self.feasible(U)
 
     def scalar(self) -> Callable[[np.ndarray], float]:
         """``x (dim,) -> float`` for optimisers that take one point at a time (DIRECT)."""

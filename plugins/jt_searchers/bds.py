@@ -25,12 +25,14 @@ import numpy as np
 from jt_searchers.acquisition import ExpectedDiversity, Exploration
 from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.distances import resolve
+from jt_searchers.feasibility import feasibility
 from jt_searchers.gp import FeatureGP
 from jt_searchers.optimize import maximize_direct, maximize_lbfgsb
 from jt_searchers.random_search import unit_samples
 from toolkit.errors import JtError
 
 KINDS = ("init", "explore", "diversity")
+FAILURES = ("avoid", "believe")
 
 
 class BDSSearcher(BudgetedSearcher):
@@ -41,9 +43,11 @@ class BDSSearcher(BudgetedSearcher):
 
         def check(self) -> None:
 
-            """budget and batch >= 1 (one JtError line)."""
+            """budget and batch >= 1, a known ``failures`` rule (one JtError line)."""
 
             check_budget(self)
+            if self.failures not in FAILURES:
+                raise JtError(f"search.failures={self.failures!r}: choose one of {', '.join(FAILURES)}")
 
         budget: int = 10
         """Total evaluations incl. initial samples; 000 §7.1.1 reports the first ten."""
@@ -67,6 +71,10 @@ class BDSSearcher(BudgetedSearcher):
         """Extra seeded restarts of the GP marginal-likelihood fit (ours)."""
         feature_distance: Optional[str] = None
         """Euclidean | angle | quaternion; null = the task's (SearchProblem.feature_distance)."""
+        failures: str = "avoid"
+        """Told points without a feature: "avoid" weights both acquisitions by the probability of a
+        feature (a +-1 label GP, as in constrained BO, Gelbart et al. 2014; ours, 000 is silent and
+        a laptop run re-sampled one failed corner three times) | "believe" only kriging-believes them."""
 
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
@@ -131,9 +139,16 @@ class BDSSearcher(BudgetedSearcher):
 
     # ---- picks ----------------------------------------------------------------------------------
 
-    def _explore(self, gp: FeatureGP, j: int) -> tuple[np.ndarray, float]:
+    def _feasibility(self) -> Any:
+        """``p(feature | x)`` from the told outcomes (``failures="avoid"`` and a failure told), else None."""
+        if self.cfg.failures != "avoid":
+            return None
+        U, _, ok = self._observed()
+        return feasibility(U, ok, self._gp.lengthscales)
+
+    def _explore(self, gp: FeatureGP, j: int, feasible: Any = None) -> tuple[np.ndarray, float]:
         """argmax sigma (eq 9) by L-BFGS-B from the best of 512 seeded candidates + random starts."""
-        acq = Exploration(gp)
+        acq = Exploration(gp, feasible)
         rng = np.random.default_rng(seed_int(self.seed, 3, j))
         cand = rng.random((512, self.box.dim))
         vals = acq(cand)
@@ -142,9 +157,9 @@ class BDSSearcher(BudgetedSearcher):
         starts = cand[np.concatenate([order[:1], others])]
         return maximize_lbfgsb(acq.value_and_grad, starts)
 
-    def _diversify(self, gp: FeatureGP, observed: np.ndarray) -> tuple[np.ndarray, float]:
+    def _diversify(self, gp: FeatureGP, observed: np.ndarray, feasible: Any = None) -> tuple[np.ndarray, float]:
         """argmax of the MC expected minimum feature distance (eq 7) by DIRECT."""
-        acq = ExpectedDiversity(gp, observed, self._distance, self._z)
+        acq = ExpectedDiversity(gp, observed, self._distance, self._z, feasible)
         return maximize_direct(acq.scalar(), self.box.dim, maxfun=self.cfg.direct_maxfun)
 
     def _propose(self, k: int) -> np.ndarray:
@@ -156,14 +171,15 @@ class BDSSearcher(BudgetedSearcher):
             return u
         gp = self._model()
         observed = self._believed_features(gp)
+        feasible = self._feasibility()
         picks = []
         for _ in range(k):
             j = self._n_model_picks
             if j % (c.n_exp + c.n_opt) < c.n_exp:  # Alg. 1 line 4
-                u, v = self._explore(gp, j)
+                u, v = self._explore(gp, j, feasible)
                 self.kinds.append("explore")
             else:
-                u, v = self._diversify(gp, observed)
+                u, v = self._diversify(gp, observed, feasible)
                 self.kinds.append("diversity")
             self.acq.append(v)
             self._n_model_picks += 1
