@@ -100,6 +100,7 @@ class JumpEnv(CharacterEnv):
         else:
             self.takeoff = takeoff_state(feats, spec.clip, spec.foot, spec.omega_y, v_y=spec.v_y)
         self._q0, self._qd0 = self._place(self.takeoff.q, self.takeoff.qd)
+        self.suite.update(centre_along=self.suite.crossing_along(self._qd0[:3]))  # the wall where the run crosses
         self.control_hz = float(spec.control_hz)
         self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)
         self.tracker = CrossingTracker()
@@ -201,7 +202,7 @@ class JumpEnv(CharacterEnv):
         m = R.T @ quat_to_matrix(q[3:7])
         rel = (links[1:] - root) @ R
         parts = [
-            [root[1], float(self.suite.past(root)), float(root @ self.suite.along)],
+            [root[1], float(self.suite.past(root)), float(self.suite.along_offset(root))],
             m[:, :2].T.reshape(-1), R.T @ qd[:3], R.T @ qd[3:6], q[7:], qd[6:], rel.reshape(-1),
             [self.difficulty, self.t / self.spec_.time_limit],
         ]
@@ -217,7 +218,11 @@ class JumpEnv(CharacterEnv):
         self.t = float(rec["time"])
         smp = rec["samples"]
         if len(smp["time"]):
-            self.tracker.update_many(smp["time"], self.suite.past(smp["com"]), smp["root"][:, 3:7])
+            past = self.suite.past(smp["com"])
+            if self.tracker.update_many(smp["time"], past, smp["root"][:, 3:7]) \
+                    and self.suite.beside(smp["com"][int(np.argmax(past >= 0.0))]):
+                self.tracker.reset()  # round the end of the wall: no crossing, no feature
+                return self._finish(False, "passed beside the bar")
         mat = rec["touched"].get(self.suite.mat_id)
         if mat is not None and not self.landed:
             self.landed, self.head_first = True, HEAD_LINK in mat

@@ -9,6 +9,9 @@ angle ``alpha`` orients the wall by the line ``x sin(alpha) - z cos(alpha) = 0``
 frame (``000`` App. A); we shift that line by ``distance`` along its normal
 ``n = (sin alpha, 0, -cos alpha)`` so the take-off point lies ``distance`` before the bar plane
 (our reading: the line through the take-off point itself would put the bar under the jumper).
+Along the bar, the wall and the mat are centred where the take-off velocity's horizontal line
+crosses the bar plane (``centre_along``; ours): a run-up at a shallow angle crosses 1.5-2 m along
+the bar, which a wall centred on the foot of the perpendicular would leave near its end.
 
 Obstacle / long jump: a box of ``height`` (50 cm, ``000`` §6.1) and variable ``width`` along the
 run direction (+x), ``distance`` ahead of the take-off point; the mat begins behind it. A long
@@ -40,6 +43,7 @@ class SuiteSpec:
     mat_depth: float = 3.0  # ours: extent behind the bar / obstacle
     mat_length: float = 5.0  # ours: extent along the bar
     gap: float = 0.01  # between the wall/obstacle and the mat (ours)
+    centre_along: float = 0.0  # m along the bar of the wall's and mat's centres (ours; Suite.crossing_along)
 
 
 def _quat_from_columns(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[float]:
@@ -91,7 +95,7 @@ class Suite:
              rgba: tuple[float, ...]) -> int:
         half = [length / 2, height / 2, depth / 2]  # local x along the bar, y up, z along normal
         orn = _quat_from_columns(self.along, self.up, np.cross(self.along, self.up))
-        pos = centre_n * self.normal + (height / 2) * self.up
+        pos = centre_n * self.normal + self.spec.centre_along * self.along + (height / 2) * self.up
         return self.sim.add_box(half, list(pos), orn, rgba, friction=0.9)
 
     def build(self, spec: SuiteSpec) -> None:
@@ -117,6 +121,28 @@ class Suite:
             return False
         self.build(new)
         return True
+
+    #: largest |centre_along| (m): a take-off this oblique cannot reach the plane in flight anyway
+    MAX_CENTRE_ALONG = 5.0
+
+    def crossing_along(self, velocity: np.ndarray) -> float:
+        """Where along the bar the straight horizontal line of ``velocity`` ``(3,)`` from the take-off
+        point crosses the feature plane (m, clipped to ``MAX_CENTRE_ALONG``); 0 when it never does."""
+        v = np.asarray(velocity, dtype=float)
+        towards = float(v @ self.normal)
+        if towards <= 1e-3:
+            return 0.0
+        s = self.plane * float(v @ self.along) / towards
+        return float(np.clip(s, -self.MAX_CENTRE_ALONG, self.MAX_CENTRE_ALONG))
+
+    def beside(self, points: np.ndarray) -> np.ndarray:
+        """Whether ``points`` ``(..., 3)`` lie beyond the ends of the wall / obstacle ``(...)``."""
+        length = self.spec.wall_length if self.spec.kind == "highjump" else self.spec.mat_length
+        return np.abs(self.along_offset(points)) > length / 2
+
+    def along_offset(self, points: np.ndarray) -> np.ndarray:
+        """Position of ``points`` ``(..., 3)`` along the bar, from the wall's centre ``(...)``."""
+        return np.asarray(points) @ self.along - self.spec.centre_along
 
     # ------------------------------------------------------------------ queries
     def past(self, points: np.ndarray) -> np.ndarray:

@@ -164,3 +164,48 @@ def test_holding_the_takeoff_pose_clears_a_low_bar_only_with_the_jumping_intenti
             assert info["reason"] == "touched the bar"
     finally:
         env.close()
+
+
+def _hold_to_the_end(env) -> tuple[dict, list]:
+    """Hold the take-off pose over a 20 cm bar to the end; the info and the CoM ``(past, along
+    offset)`` per step."""
+    env.bar_height = 0.2
+    env.reset(seed=0)
+    hold = env.skeleton.joints_to_dofs(env._q0[7:]).astype(np.float32)
+    done, info, path = False, {}, []
+    while not done:
+        _, _, done, _, info = env.step(hold)
+        com = env._com_and_links()[0]
+        path.append((float(env.suite.past(com)), float(env.suite.along_offset(com))))
+    return info, path
+
+
+def test_the_wall_stands_where_the_jump_crosses_its_plane():
+    """The wall and the mat are centred where the take-off velocity crosses the bar plane; a
+    hold-pose jump crosses within 0.6 m of that centre (1.6 m from the foot of the perpendicular)."""
+    from jt_tasks.jumping.env import JumpEnv
+
+    env = JumpEnv(make_spec(features={"alpha": 0.01, "omega_x": -2.5, "omega_z": 0.34, "v_z": -1.17},
+                            v_y=2.06), seed=0)
+    try:
+        assert env.suite.spec.centre_along > 1.5
+        info, path = _hold_to_the_end(env)
+        assert info["crossed"] and info["success"]
+        at = np.array(path)[np.argmax(np.array(path)[:, 0] >= 0)]
+        assert abs(at[1]) < 0.6
+    finally:
+        env.close()
+
+
+def test_passing_round_the_end_of_the_wall_is_no_crossing():
+    from jt_tasks.jumping.env import JumpEnv
+
+    env = JumpEnv(make_spec(features={"alpha": 0.01, "omega_x": -2.5, "omega_z": 0.34, "v_z": -1.17},
+                            v_y=2.06), seed=0)
+    try:
+        env.suite.update(centre_along=env.suite.spec.centre_along + 3.0)  # the wall ends 1 m short of the jump
+        info, _ = _hold_to_the_end(env)
+        assert info["reason"] == "passed beside the bar" and not info["crossed"] and not info["success"]
+        assert np.isnan(info["feature_angle"])
+    finally:
+        env.close()

@@ -11,6 +11,11 @@ crosses the bar plane) now takes the CoM of the state just integrated (forward k
 simulator's substep loop) instead of PyBullet's cached link frames, which lag one 600 Hz substep
 behind; the crossing is found one substep earlier, moving the feature by ~0.005 rad. Everything
 else — every PPO statistic, the trajectory — is unchanged to the last digit.
+
+A second, in session 5: the high jump's wall and mat are centred where the take-off velocity
+crosses the bar plane (docs/highjump.md), which moves the scene and the along-the-bar coordinate
+of the observation, so ``highjump_smoke.json`` was re-recorded on that change (its
+``recorded_at`` says so); ``runup_smoke.json`` is still the recording from before the layer.
 """
 
 from __future__ import annotations
