@@ -5,6 +5,10 @@ from __future__ import annotations
 import dataclasses
 import multiprocessing as mp
 import os
+import signal
+import sys
+import threading
+import time
 import traceback
 from typing import Any, Callable, Iterator, Optional, Sequence
 
@@ -18,7 +22,72 @@ def _limit_threads() -> None:
         os.environ[var] = "1"
 
 
-def _actor_main(conn: Any, factory: Callable[..., Any], args: tuple) -> None:
+#: seconds between two looks of the watchdog thread at this worker's parent
+WATCHDOG_PERIOD_S = 0.5
+
+
+def _arm_pdeathsig() -> bool:
+    """Ask Linux to SIGKILL this process when its parent ends (``prctl(PR_SET_PDEATHSIG)``).
+
+    Returns:
+        True when armed (Linux with a C library that has ``prctl``), False elsewhere.
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        return libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch_parent(ppid: int, period: float) -> None:
+    """Exit this process as soon as its parent is no longer ``ppid`` (the parent died and the
+    worker was re-parented): the portable fallback of ``_arm_pdeathsig``."""
+    while True:
+        time.sleep(period)
+        if os.getppid() != ppid:
+            os._exit(1)
+
+
+def _die_with_parent(parent_pid: Optional[int], pdeathsig: bool) -> None:
+    """Make this worker process end when the process that started it ends, even by ``kill -9``.
+
+    A driver killed by SIGKILL runs no clean-up, and a pool worker or actor blocked on its pipe
+    would otherwise live on under init, holding a core and its memory. Two mechanisms: on Linux
+    the kernel SIGKILLs the worker when its parent dies (``PR_SET_PDEATHSIG``); everywhere a
+    daemon thread polls ``os.getppid()`` every ``WATCHDOG_PERIOD_S`` seconds and exits the worker
+    when it changes (a worker blocked in C code that holds the GIL is only caught by the first).
+
+    Args:
+        parent_pid: the pid of the process expected to be this worker's parent (the driver for the
+            ``spawn`` and ``fork`` start methods); if the worker's parent is already another
+            process, the driver died before this ran and the worker exits now. None: not known
+            (``forkserver``: the parent is the fork server, which itself exits with the driver).
+        pdeathsig: arm ``PR_SET_PDEATHSIG``. Linux sends it when the parent *thread* that started
+            the worker ends, so the caller passes True only when that thread is the main thread.
+    """
+    if pdeathsig:
+        _arm_pdeathsig()
+    ppid = os.getppid()
+    if parent_pid is not None and ppid != parent_pid:
+        os._exit(1)  # orphaned before the guard was armed
+    threading.Thread(target=_watch_parent, args=(ppid, WATCHDOG_PERIOD_S), name="jt-parent-watchdog",
+                     daemon=True).start()
+
+
+def _worker_init(parent_pid: Optional[int], pdeathsig: bool) -> None:
+    """Pool worker initializer: die with the driver, then one BLAS/torch thread."""
+    _die_with_parent(parent_pid, pdeathsig)
+    _limit_threads()
+
+
+def _actor_main(conn: Any, factory: Callable[..., Any], args: tuple, parent_pid: Optional[int] = None,
+                pdeathsig: bool = False) -> None:
+    _die_with_parent(parent_pid, pdeathsig)
     _limit_threads()
     try:
         obj = factory(*args)
@@ -45,12 +114,20 @@ class WorkerError(RuntimeError):
 
 
 
+def _guard_args(method: str) -> tuple[Optional[int], bool]:
+    """``(parent_pid, pdeathsig)`` for ``_die_with_parent`` of a worker started now, from this
+    thread, with start method ``method``."""
+    parent = None if method == "forkserver" else os.getpid()
+    return parent, threading.current_thread() is threading.main_thread()
+
+
 class _ProcessActors(ActorGroup):
     def __init__(self, ctx: Any, factory: Callable[..., Any], args: Sequence[tuple]) -> None:
         self._conns, self._procs = [], []
+        guard = _guard_args(ctx.get_start_method())
         for a in args:
             parent, child = ctx.Pipe()
-            p = ctx.Process(target=_actor_main, args=(child, factory, a), daemon=True)
+            p = ctx.Process(target=_actor_main, args=(child, factory, a, *guard), daemon=True)
             p.start()
             self._conns.append(parent)
             self._procs.append(p)
@@ -87,7 +164,11 @@ class _ProcessActors(ActorGroup):
 
 
 class LocalExecutor(Executor):
-    """Process pool on this machine; one worker per core by default."""
+    """Process pool on this machine; one worker per core by default.
+
+    Pool workers and actors end with the process that started them, even when it is killed with
+    ``kill -9`` (``_die_with_parent``): no orphan keeps a core after its driver is gone.
+    """
 
     @dataclasses.dataclass
     class Config:
@@ -106,6 +187,7 @@ class LocalExecutor(Executor):
         self._workers = workers if workers > 0 else (os.cpu_count() or 1)
         self._method = str(params.start_method)
         self._pool: Optional[Any] = None
+        self._pool_pdeathsig = False
 
     @property
     def n_workers(self) -> int:
@@ -121,10 +203,16 @@ class LocalExecutor(Executor):
             return
         from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
+        guard = _guard_args(self._method)
+        if self._pool is not None and self._pool_pdeathsig and not guard[1]:
+            # workers may be started by this thread now, and their PDEATHSIG would fire when it ends
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
         if self._pool is None:
             self._pool = ProcessPoolExecutor(
-                max_workers=self._workers, mp_context=self._context(), initializer=_limit_threads
+                max_workers=self._workers, mp_context=self._context(), initializer=_worker_init, initargs=guard
             )
+            self._pool_pdeathsig = guard[1]
         futures = {self._pool.submit(fn, x): i for i, x in enumerate(items)}
         pending = set(futures)
         try:
