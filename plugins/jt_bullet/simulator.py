@@ -165,6 +165,16 @@ class BulletSimulator(SceneQueries, Simulator):
         return ch
 
     # ------------------------------------------------------------------ Simulator API
+    @property
+    def sim_hz(self) -> float:
+        """``sim.sim_hz`` (Hz)."""
+        return float(self.params.sim_hz)
+
+    @property
+    def control_hz(self) -> float:
+        """``sim.control_hz`` (Hz)."""
+        return float(self.params.control_hz)
+
     def reset(self, q: np.ndarray, qd: np.ndarray) -> None:
         """Put the character in state ``(q, qd)`` (``toolkit.dynamics`` layout); time = 0."""
         self.io.reset(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))

@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import abc
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.plugin import GroupPlugin
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
 
-class ActionSpace(Plugin, abc.ABC):
+class ActionSpace(GroupPlugin, abc.ABC):
     """Maps a policy's action vector to PD targets, once per control step.
 
     Required: ``dim``, ``bounds``, ``reset``, ``targets``. Optional, with defaults: ``penalty``
@@ -32,12 +32,14 @@ class ActionSpace(Plugin, abc.ABC):
         character: the character description the targets are for.
     """
 
+    what: ClassVar[str] = "action={name}"
+
     skeleton: Any = None
     filtered: Any = None
 
     def __init__(self, cfg: Any, character: Any = None) -> None:
-        self.cfg = cfg
         self.character = character
+        super().__init__(cfg)
 
     @property
     @abc.abstractmethod

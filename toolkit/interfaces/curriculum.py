@@ -5,10 +5,10 @@ from __future__ import annotations
 import abc
 from typing import Any, ClassVar
 
-from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.plugin import GroupPlugin
 
 
-class Curriculum(Plugin, abc.ABC):
+class Curriculum(GroupPlugin, abc.ABC):
     """Holds a difficulty state and updates it from episode outcomes.
 
     Required: ``update``, ``state``, ``load_state``. What the policy tasks call, with defaults:
@@ -25,10 +25,12 @@ stop early). ``jt_curricula.base.IterationCurriculum``
         cfg: the ``curriculum`` config group, validated against ``Config``.
     """
 
+    what: ClassVar[str] = "curriculum={name}"
+
     extra_key: ClassVar[str] = "curriculum"
 
     def __init__(self, cfg: Any = None) -> None:
-        self.cfg = cfg
+        super().__init__(cfg)
 
     @abc.abstractmethod
     def update(self, episode: dict[str, Any]) -> None:

@@ -52,3 +52,38 @@ class Plugin:
         d = OmegaConf.to_container(cfg, resolve=True) if not isinstance(cfg, dict) else dict(cfg)
         d.pop("name", None)
         return d
+
+
+class GroupPlugin(Plugin):
+    """A plugin configured by its own config group (reward terms, action spaces, curricula, SPD
+    backends): ``cfg`` is that group, and ``params`` its validated ``Config`` instance.
+
+    Attributes:
+        params: ``Config`` validated from ``cfg`` (``toolkit.schema.config_of``) when the base
+            ``__init__`` runs, so a plugin whose ``__init__`` calls ``super().__init__(cfg)`` has
+            it (and its one-line error for a wrong key) without writing a line; an
+            implementation may also assign it. The shipped contract suites read it.
+    """
+
+    cfg: Any = None
+    #: how an error names the plugin (``{name}``: its registry name)
+    what: ClassVar[str] = "{name}"
+
+    def __init__(self, cfg: Any = None) -> None:
+        self.cfg = cfg
+        self.params  # noqa: B018 - validated now: a wrong key or type is one line at construction
+
+    @property
+    def params(self) -> Any:
+        p = self.__dict__.get("_params")
+        if p is None:
+            from toolkit.schema import config_of
+
+            name = type(self).name or type(self).__name__
+            p = config_of(type(self).Config, self.cfg, type(self).what.format(name=name))
+            self.__dict__["_params"] = p
+        return p
+
+    @params.setter
+    def params(self, value: Any) -> None:
+        self.__dict__["_params"] = value

@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import abc
-from typing import Any
+from typing import Any, ClassVar
 
-from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.plugin import GroupPlugin
 
 
-class RewardTerm(Plugin, abc.ABC):
+class RewardTerm(GroupPlugin, abc.ABC):
     """A scalar factor computed from a step (or episode) record.
 
     Args:
         cfg: this term's parameters, validated against ``Config``.
     """
 
+    what: ClassVar[str] = "reward term {name}"
+
     def __init__(self, cfg: Any = None) -> None:
-        self.cfg = cfg
+        super().__init__(cfg)
 
     @abc.abstractmethod
     def __call__(self, record: dict[str, Any]) -> float:

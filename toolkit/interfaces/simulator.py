@@ -92,7 +92,7 @@ class Simulator(Plugin, abc.ABC):
             opening a planar (2-D) world for ``task=standing_jump``; None (default): this
             simulator has none, and that task says so.
 
-    Required: ``reset``, ``step``, ``state`` and the queries and scene methods below that a task
+    Required: ``sim_hz``, ``control_hz``, ``reset``, ``step``, ``state`` and the queries and scene methods below that a task
     uses (the defaults raise ``NotImplementedError``); ``close`` releases the engine.
 
     Args:
@@ -109,6 +109,18 @@ class Simulator(Plugin, abc.ABC):
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg
+
+    # ------------------------------------------------------------------ rates
+    @property
+    @abc.abstractmethod
+    def sim_hz(self) -> float:
+        """Substep rate (Hz): the rate SPD and contacts run at (600 in the papers)."""
+
+    @property
+    @abc.abstractmethod
+    def control_hz(self) -> float:
+        """Default control rate (Hz); ``step`` runs ``sim_hz / control_hz`` substeps unless told
+        otherwise (a task with its own rate passes ``n_substeps``)."""
 
     # ------------------------------------------------------------------ state and stepping
     @abc.abstractmethod

@@ -5,13 +5,13 @@ from __future__ import annotations
 import abc
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from toolkit.interfaces.plugin import Plugin
+from toolkit.interfaces.plugin import GroupPlugin
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
 
-class SPDBackend(Plugin, abc.ABC):
+class SPDBackend(GroupPlugin, abc.ABC):
     """Computes Stable PD torques (thesis ``001`` eq 2.4/2.6) at the current state.
 
     Generalised coordinates follow ``toolkit.dynamics`` (= PyBullet's ``getBase*`` and
@@ -38,10 +38,12 @@ class SPDBackend(Plugin, abc.ABC):
         cfg: the ``spd`` config group, validated against ``Config``.
     """
 
+    what: ClassVar[str] = "spd={name}"
+
     steps_itself: ClassVar[bool] = False
 
     def __init__(self, cfg: Any = None) -> None:
-        self.cfg = cfg
+        super().__init__(cfg)
 
     @abc.abstractmethod
     def bind(self, body: Any) -> None:

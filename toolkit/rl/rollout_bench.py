@@ -44,7 +44,7 @@ def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps:
     """
     env = make_env()
     try:
-        if not _set_control_rate(env, control_hz) and abs(env.sim.params.control_hz - control_hz) > 1e-9:
+        if not _set_control_rate(env, control_hz) and abs(env.sim.control_hz - control_hz) > 1e-9:
             return {}
         rng = np.random.default_rng(seed)
         low, high = env.action_space.low, env.action_space.high

@@ -67,14 +67,18 @@ class SimulatorContract:
         np.testing.assert_allclose(qd2[:3], qd[:3], atol=1e-9)
         assert sim.time == 0.0
 
+    def test_declares_its_rates(self, sim):
+        assert sim.sim_hz > 0 and sim.control_hz > 0
+        assert sim.n_substeps == round(sim.sim_hz / sim.control_hz)
+
     def test_step_runs_its_substeps_and_advances_time(self, sim):
         q, qd = self._lifted(sim, 0.5)
         rec = sim.step(q)
         assert rec["substeps"] == sim.n_substeps and not rec["failed"] and rec["outcome"] == ""
-        assert sim.time == pytest.approx(sim.n_substeps / 600.0)
+        assert sim.time == pytest.approx(sim.n_substeps / sim.sim_hz)
         rec = sim.step(q, n_substeps=3)
         assert rec["substeps"] == 3
-        assert sim.time == pytest.approx((sim.n_substeps + 3) / 600.0)
+        assert sim.time == pytest.approx((sim.n_substeps + 3) / sim.sim_hz)
         assert rec["q"].shape == q.shape and rec["qd"].shape == qd.shape
 
     def test_a_nan_state_fails_and_never_raises(self, sim):

@@ -92,7 +92,7 @@ class GetupEnv(CharacterEnv):
         if not self.curves:
             raise ValueError("getup: no feature curves")
         self.curve_starts = np.array([c.start for c in self.curves])
-        self.control_hz = float(self.sim.params.control_hz)
+        self.control_hz = float(self.sim.control_hz)
         self.dt = 1.0 / self.control_hz
         terms = dict((spec.reward or {}).get("terms") or {})
         self.terms = {str(k): plugins.load("reward", str(k))(v) for k, v in terms.items()}

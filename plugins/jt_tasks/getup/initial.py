@@ -144,7 +144,7 @@ def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = S
         where = T.sample_locations(tspec, int(region), n, np.random.default_rng([int(seed), int(region)]))
     out = []
     try:
-        steps = int(round(settle_max * float(sim.params.control_hz)))
+        steps = int(round(settle_max * float(sim.control_hz)))
         for i in range(n):
             style = styles[i % len(styles)]
             xz = where[i] if tspec is not None else np.zeros(2)
@@ -159,7 +159,7 @@ def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = S
                 for k in range(steps):
                     q, qd = sim.state()
                     rec = sim.step(q)
-                    t = (k + 1) / float(sim.params.control_hz)
+                    t = (k + 1) / float(sim.control_hz)
                     if rec["failed"]:
                         failed = True
                         break

@@ -199,7 +199,9 @@ class GetupTask(PolicyTask):
         if cur is not None:
             if res.extra.get(cur.extra_key):
                 cur.load_state(dict(res.extra[cur.extra_key]))
-            metrics["terrain_level"] = float(cur.state()["level"])
+            level = cur.env_attrs().get("terrain_level")  # what the env reads (Curriculum.env_attrs)
+            if level is not None:
+                metrics["terrain_level"] = float(level)
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         hist = np.asarray(res.extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
         hist = hist.reshape(-1, 1 + len(HISTORY))

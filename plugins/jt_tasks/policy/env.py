@@ -66,7 +66,7 @@ class CharacterEnv(gymnasium.Env):
         self.spec_ = spec
         self.render_mode = render_mode
         self.sim = load_simulator(spec.sim)
-        self.sim_hz = float(self.sim.params.sim_hz)
+        self.sim_hz = float(self.sim.sim_hz)
         self.n_links = int(self.sim.n_links)
         self.masses = np.asarray(self.sim.masses)
         action = dict(spec.action)
