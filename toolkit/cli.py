@@ -147,8 +147,9 @@ def ui_cmd(
 
             webbrowser.open(str(root))
         return
-    from toolkit.store.ui import serve, url
+    from toolkit.store.ui import check, serve, url
 
+    check(root, port)  # a busy port, a bind beyond loopback, a bad store: one line, no URL printed
     typer.echo(f"MLflow UI for {root}: {url(port)}  (Ctrl-C to stop)")
     serve(root, port)
 

@@ -1,17 +1,22 @@
 """jt ui: MLflow's UI with one worker and no job runners; SIGTERM stops it with the server, also
-when jt was started as a shell's background job."""
+when jt was started as a shell's background job, and so does Ctrl-C; a busy or invalid port and an
+environment that would make the server listen beyond loopback are one line and exit 2."""
 
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
 import urllib.request
 
-from tests.conftest import jt_env
+import pytest
+
+from tests.conftest import jt_env, run_jt
 from tests.plugins.jt_executors.ray_cluster import free_port
+from toolkit.errors import JtError
 from toolkit.store.tracking import Store
-from toolkit.store.ui import command
+from toolkit.store.ui import check_env, check_port, command
 
 
 def _children(pid):
@@ -68,11 +73,126 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
 
 
 def test_a_bad_store_is_one_line_before_mlflow_starts(tmp_path):
-    import pytest
-
-    from toolkit.errors import JtError
     from toolkit.store.ui import serve
 
     (tmp_path / "mlflow.db").write_bytes(b"not a database")
     with pytest.raises(JtError, match="not an SQLite database"):
         serve(tmp_path, free_port())
+
+
+# ---------------------------------------------------------------------------- refused before MLflow starts
+def test_a_busy_port_is_one_line_and_exit_2(tmp_path):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        out = run_jt("ui", f"store={tmp_path / 's'}", "--port", str(port), timeout=60)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+    assert f"--port {port}: 127.0.0.1:{port} is already in use" in out.stderr
+    assert "MLflow UI for" not in out.stdout and not (tmp_path / "s").exists()  # no URL, no store made
+
+
+@pytest.mark.parametrize("port", ["0", "70000", "-1", "abc"])
+def test_an_invalid_port_is_one_line_and_exit_2(tmp_path, port):
+    out = run_jt("ui", f"store={tmp_path / 's'}", "--port", port, timeout=60)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1 and "--port" in out.stderr, out.stderr
+    assert "MLflow UI for" not in out.stdout
+
+
+def test_check_port_accepts_a_free_port():
+    check_port(free_port())
+    for bad in (0, 65536, True, "5000"):
+        with pytest.raises(JtError, match="from 1 to 65535"):
+            check_port(bad)
+
+
+@pytest.mark.parametrize("env", [
+    {"MLFLOW_GUNICORN_OPTS": "--timeout 60 -b 0.0.0.0:5000"},
+    {"MLFLOW_GUNICORN_OPTS": "--bind=:5000"},
+    {"MLFLOW_GUNICORN_OPTS": "-b[::]:5000"},
+    {"MLFLOW_GUNICORN_OPTS": "--bind fd://3"},
+    {"MLFLOW_GUNICORN_OPTS": "-b myhost.example.org:80"},
+    {"GUNICORN_CMD_ARGS": "--bind=10.0.0.5:5000"},
+    {"MLFLOW_UVICORN_OPTS": "--host 0.0.0.0"},
+    {"MLFLOW_UVICORN_OPTS": "--host=::"},
+    {"MLFLOW_UVICORN_OPTS": "--fd 3"},
+    {"UVICORN_FD": "3"},
+    {"MLFLOW_UVICORN_OPTS": "--host 'unbalanced"},
+])
+def test_environment_binding_beyond_loopback_is_refused(env):
+    with pytest.raises(JtError, match="jt ui serves on 127.0.0.1 only") as e:
+        check_env(env)
+    assert "\n" not in str(e.value) and next(iter(env)) in str(e.value)
+
+
+@pytest.mark.parametrize("env", [
+    {},
+    {"MLFLOW_GUNICORN_OPTS": "--timeout 60 -b 127.0.0.1:5000 --bind [::1]:5000 -b localhost:1 -b unix:/tmp/s"},
+    {"MLFLOW_UVICORN_OPTS": "--timeout-keep-alive 30 --host 127.0.0.2 --uds /tmp/mlflow.sock"},
+    {"MLFLOW_HOST": "0.0.0.0", "UVICORN_HOST": "0.0.0.0"},  # jt's --host 127.0.0.1 wins over both
+    {"GUNICORN_CMD_ARGS": "", "UVICORN_FD": " "},
+])
+def test_environment_on_loopback_is_accepted(env):
+    check_env(env)
+
+
+def test_jt_ui_refuses_a_bind_beyond_loopback_in_one_line(tmp_path):
+    env = {**jt_env(), "MLFLOW_GUNICORN_OPTS": "-b 0.0.0.0:5000"}
+    out = subprocess.run([sys.executable, "-m", "toolkit.cli", "ui", f"store={tmp_path / 's'}", "--port",
+                          str(free_port())], capture_output=True, text=True, env=env, timeout=60)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+    assert "MLFLOW_GUNICORN_OPTS makes MLflow's server listen on 0.0.0.0:5000" in out.stderr
+
+
+# ---------------------------------------------------------------------------- Ctrl-C stops the server tree
+FAKE_UI = """
+import os, subprocess, sys, time
+from pathlib import Path
+from toolkit.store import ui
+
+def fake_command(root, port):  # a server process with a worker of its own, as MLflow + uvicorn
+    tree = ("import os, subprocess, sys, time; c = subprocess.Popen([sys.executable, '-c', 'import time; "
+            "time.sleep(600)']); open(sys.argv[1], 'w').write(f'{os.getpid()} {c.pid}'); time.sleep(600)")
+    return [sys.executable, "-c", tree, str(root / "pids")], dict(os.environ)
+
+ui.command = fake_command
+from toolkit.cli import main
+sys.argv = ["jt", "ui", f"store={sys.argv[1]}", "--port", sys.argv[2]]
+main()
+"""
+
+
+def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
+    """SIGINT to ``jt ui`` (Ctrl-C in its terminal; the server has a session of its own, so only jt
+    gets it) ends the server's whole process group. MLflow is replaced by a two-process tree."""
+    import sqlite3
+
+    root = tmp_path / "s"
+    root.mkdir()
+    sqlite3.connect(root / "mlflow.db").execute("create table t (x)").connection.close()  # a store: no MLflow
+    proc = subprocess.Popen([sys.executable, "-c", FAKE_UI, str(root), str(free_port())], env=jt_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
+            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate(timeout=10)
+            time.sleep(0.1)
+        pids = [int(p) for p in (root / "pids").read_text().split()]
+        assert all(os.path.exists(f"/proc/{p}") for p in pids)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == 0
+        deadline = time.monotonic() + 10
+        while any(os.path.exists(f"/proc/{p}") and "Z" not in _state(p) for p in pids) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not [p for p in pids if os.path.exists(f"/proc/{p}") and "Z" not in _state(p)], "outlived jt ui"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def _state(pid):
+    try:
+        return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "Z"
