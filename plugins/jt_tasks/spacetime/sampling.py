@@ -81,19 +81,28 @@ def boltzmann_draw(w: np.ndarray, m: int, rng: np.random.Generator, reading: str
 
 @dataclasses.dataclass
 class SamplingParams:
-    """The knobs of ``StartSampler`` (``task.sampling``; defaults and sources in ``SpacetimeConfig``)."""
+    """The knobs of ``StartSampler``, all required: their defaults and sources live once, in
+    ``SpacetimeConfig`` (``task.*``), which builds this with ``sampling_params()``; ``defaults()``
+    gives that (for tests and scripts)."""
 
-    importance: bool = True
-    n_segments: int = 10
-    uniform: float = 0.2
-    average: float = 0.99
-    is_reading: str = "paper"
-    evolution: bool = False
-    buffer_size: int = 200
-    share: float = 1.0
-    warmup: int = 0
-    evolution_reading: str = "paper"
-    decay: float = 1.0
+    importance: bool
+    n_segments: int
+    uniform: float
+    average: float
+    is_reading: str
+    evolution: bool
+    buffer_size: int
+    share: float
+    warmup: int
+    evolution_reading: str
+    decay: float
+
+    @classmethod
+    def defaults(cls, **changes: Any) -> "SamplingParams":
+        """``SpacetimeConfig()``'s knobs (the paper's), with ``changes`` applied."""
+        from jt_tasks.spacetime.task import SpacetimeConfig
+
+        return dataclasses.replace(SpacetimeConfig().sampling_params(), **changes)
 
 
 class StartSampler:
