@@ -44,6 +44,21 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
     if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
         raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
                       f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
+    trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
+
+
+def trained_policy(cfg: Any, task: str) -> Optional[Path]:
+    """The ``ppo.h5`` that ``task.evaluate`` names (a run id, a folder or the file), or None when
+    it is unset; one ``JtError`` line when it names nothing."""
+    ref = str(group_of(group_of(cfg, "task") or {}, "evaluate") or "").strip()
+    if not ref:
+        return None
+    from toolkit.store.resolve import resolve
+
+    store = group_of(cfg, "store")
+    return resolve(ref, artifact=tr.CHECKPOINT, store=None if store is None else str(store),
+                   what="task.evaluate", label="trained policy",
+                   hint=f"train one with: jt run task={task}").path
 
 
 @dataclasses.dataclass
@@ -58,6 +73,10 @@ class PolicyConfig:
     """px per frame."""
     filmstrip_height: int = 120
     """px."""
+    evaluate: str = ""
+    """A trained policy to measure instead of training one: a run id (its best evaluation), a
+    folder or a ``ppo.h5``. Its policy is rolled out and measured with this run's settings and
+    no sample is collected (jt; e.g. ``003`` Table 1 of a policy trained earlier)."""
 
 
 @dataclasses.dataclass
@@ -156,7 +175,8 @@ class PolicyTask(Task):
         spec = hooks.spec if hooks.spec is not None else spec
         trained = tr.train_policy(tr.EnvFactory(self.env_class, spec), group_of(self.cfg, "agent"),
                                   group_of(self.cfg, "executor"), workdir, ctx.seed, hooks.on_iteration,
-                                  hooks.extra, hooks.should_stop, hooks.warm_start)
+                                  hooks.extra, hooks.should_stop, hooks.warm_start,
+                                  self._adopt_trained(workdir))
         model = load_policy(trained.checkpoint)
         env = self.env_class(spec, seed=ctx.seed)
         try:
@@ -177,6 +197,23 @@ class PolicyTask(Task):
             ev.artifacts = [n for n in (tr.CHECKPOINT, "rollout.h5", *written) if (workdir / n).exists()] + \
                 self.extra_artifacts(workdir)
         return ev
+
+    def _adopt_trained(self, workdir: Path) -> Optional[Callable[[Any], Any]]:
+        """With ``task.evaluate``: copy its checkpoint into ``workdir`` (where training resumes from)
+        and return the ``PPOConfig`` change that makes its sample count the budget, so PPO resumes
+        with nothing left to collect; None without it."""
+        import shutil
+
+        from toolkit.rl.checkpoint import load, with_architecture
+
+        src = trained_policy(self.cfg, type(self).name or self.Config().name)
+        if src is None:
+            return None
+        dst = Path(workdir) / tr.CHECKPOINT
+        if not dst.exists():
+            shutil.copyfile(src, dst)
+        done = int(load(dst)[0]["counters"]["samples"])
+        return lambda c: dataclasses.replace(with_architecture(c, dst), total_samples=done)
 
     def extra_artifacts(self, workdir: Path) -> list[str]:
         """Files of the task's own that the evaluation logs besides the shared ones."""

@@ -1,0 +1,38 @@
+"""``task.evaluate=RUN``: a trained policy measured again without training (the policy layer)."""
+
+from __future__ import annotations
+
+import pytest
+
+from toolkit.errors import JtError
+
+
+def _run(tmp_path, *extra):
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    return run(compose(["task=runup", "experiment=smoke", f"store={tmp_path}", *extra]))
+
+
+def _metrics(res):
+    return res.store.client.get_run(res.run_id).data.metrics
+
+
+def test_evaluating_a_trained_run_collects_nothing_and_measures_the_same(tmp_path):
+    trained = _run(tmp_path)
+    again = _run(tmp_path, f"task.evaluate={trained.run_id}")
+    m0, m1 = _metrics(trained), _metrics(again)
+    assert m1["samples"] == m0["samples"] and m1["iterations"] == m0["iterations"]
+    for key in ("mean_return", "imitation_reward", "goal_reward", "episode_time"):
+        assert m1[key] == pytest.approx(m0[key], abs=1e-9), key
+    # the folder holding ppo.h5 works the same as the run id
+    folder = trained.store.artifact_dir(trained.run_id)
+    assert _metrics(_run(tmp_path, f"task.evaluate={folder}"))["mean_return"] == pytest.approx(m0["mean_return"])
+
+
+def test_a_missing_trained_run_is_one_line_before_a_run_opens(tmp_path):
+    from toolkit.config import compose
+
+    with pytest.raises(JtError, match=r"task.evaluate=nope: .*train one with: jt run task=runup"):
+        compose(["task=runup", "experiment=smoke", f"store={tmp_path}", "task.evaluate=nope"])
+    assert not (tmp_path / "mlflow.db").exists()
