@@ -68,22 +68,42 @@ class GetupTask(PolicyTask):
     def fallen(self, sim: dict, regions: Optional[list[int]] = None, n: Optional[int] = None,
                seed: Optional[int] = None) -> list:
         """Rag-doll states of ``regions`` (default: ``train_regions()``), ``n`` each (``n_fallen``),
-        dropped with ``seed`` (``fallen_seed``); memoised per process."""
+        dropped with ``seed`` (``fallen_seed``); memoised per process and, during an evaluation,
+        kept in its folder (``drops_<hash>.json``), so a resumed run does not drop them again."""
+        import hashlib
+        import json
+
         from jt_tasks.getup.initial import fallen_states
 
         p = self.params
+        folder = getattr(self, "_drops_dir", None)
         n = p.n_fallen if n is None else int(n)
         seed = p.fallen_seed if seed is None else int(seed)
         out = []
         for region in (self.train_regions() if regions is None else regions):
             key = (repr(sim), repr(dict(p.terrain)), region, n, seed, tuple(p.fallen_styles), p.drop_height,
                    p.drop_perturb, p.ragdoll_kd, p.settle_max, p.rest_speed, p.drop_hz)
+            cache = None if folder is None else \
+                Path(folder) / f"drops_{hashlib.sha1(repr(key).encode()).hexdigest()[:16]}.json"
+            if key not in _FALLEN and cache is not None and cache.exists():
+                _FALLEN[key] = json.loads(cache.read_text())
             if key not in _FALLEN:
                 _FALLEN[key] = fallen_states(sim, n, seed, tuple(p.fallen_styles), p.drop_height, p.drop_perturb,
                                              p.ragdoll_kd, p.settle_max, p.rest_speed,
                                              terrain=dict(p.terrain) or None, region=region, sim_hz=p.drop_hz)
+                if cache is not None:  # written whole, then renamed: a kill never leaves half a file
+                    tmp = cache.with_suffix(".json.tmp")
+                    tmp.write_text(json.dumps(_FALLEN[key]))
+                    tmp.replace(cache)
             out.extend(_FALLEN[key])
         return out
+
+    def evaluate(self, point: dict[str, float], ctx: EvalContext) -> Evaluation:
+        self._drops_dir = Path(ctx.workdir)  # the rag-doll drops are kept with the evaluation
+        try:
+            return super().evaluate(point, ctx)
+        finally:
+            self._drops_dir = None
 
     def env_spec(self, point: dict[str, float]) -> Any:
         from jt_tasks.getup.env import GetupSpec

@@ -94,3 +94,27 @@ def test_reference_clip_replayed_through_the_reward_never_terminates(curve):
     finally:
         env.close()
     assert E.longest_run(np.array([0, 1, 1, 0, 1, 1, 1, 0], bool)) == 3
+
+
+def test_drops_are_kept_with_the_evaluation_and_not_made_again(tmp_path, monkeypatch):
+    """A resumed evaluation reads its rag-doll drops from its folder instead of dropping again."""
+    from toolkit.config import compose
+
+    import jt_tasks.getup.initial as initial
+    import jt_tasks.getup.task as gt
+
+    task = gt.GetupTask(compose(["task=getup", "experiment=smoke", "task.n_fallen=2"]))
+    sim, _ = task.character_groups()
+    task._drops_dir = tmp_path
+    monkeypatch.setattr(gt, "_FALLEN", {})
+    first = task.fallen(sim)
+    files = list(tmp_path.glob("drops_*.json"))
+    assert len(first) == 2 and len(files) == 1 and not list(tmp_path.glob("*.tmp"))
+
+    def no_drops(*a, **k):
+        raise AssertionError("dropped again")
+
+    monkeypatch.setattr(gt, "_FALLEN", {})  # a new process: the memo is empty
+    monkeypatch.setattr(initial, "fallen_states", no_drops)
+    again = task.fallen(sim)
+    assert [s["q"] for s in again] == [s["q"] for s in first] and [s["qd"] for s in again] == [s["qd"] for s in first]
