@@ -11,7 +11,9 @@ schema and applies the command line's ``group.key=value`` overrides on the typed
 
 Which schema types a group:
 
-* a plugin kind's group (``task``, ``spd``, ``search``, ...): the chosen plugin's ``Config``;
+* a plugin kind's group (``task``, ``spd``, ``search``, ...): the chosen plugin's ``Config``,
+  and the keys its interface declares for every plugin of the kind (``common_keys``: the
+  ``executor`` group's ``workers``) that ``Config`` does not (``_common_keys``);
 * ``reward`` (a *set* of terms, no ``name``): each ``terms.<term>`` by that term's ``Config``;
 * groups a plugin declares in ``group_schemas`` (the ``bullet`` simulator types ``character``);
 * the core's own groups in ``CORE_GROUPS`` (``agent``: PPO's hyper-parameters).
@@ -185,6 +187,42 @@ def _plugin_schema(group: str, node: Any) -> tuple[Optional[type], Optional[type
     return cls, schema if schema is not None and dataclasses.is_dataclass(schema) else None
 
 
+def _common_keys(where: str, cls: type, schema: type, node: Any,
+                 overrides: Sequence[tuple[str, Any]]) -> tuple[Any, list[tuple[str, Any]]]:
+    """Split the keys an interface declares for every plugin of its kind (the plugin class's
+    ``common_keys`` dataclass, e.g. ``ExecutorKeys``) but the plugin's ``Config`` does not off a
+    group node and its overrides: they are typed and checked against ``common_keys``, then left
+    out, so the plugin is built from exactly the keys it declares.
+
+    Args:
+        where: how to name the group in an error (``executor=tp_serial``).
+        cls: the chosen plugin class.
+        schema: its ``Config``.
+        node: the composed group node.
+        overrides: command-line assignments inside the group.
+
+    Returns:
+        ``(node, overrides)`` without those keys (unchanged when there are none).
+
+    Raises:
+        JtError: one line: a wrong type or a value out of range.
+    """
+    from omegaconf import OmegaConf
+
+    common = getattr(cls, "common_keys", None)
+    if common is None or not dataclasses.is_dataclass(common):
+        return node, list(overrides)
+    keys = {f.name for f in dataclasses.fields(common)} - {f.name for f in dataclasses.fields(schema)}
+    if not keys:
+        return node, list(overrides)
+    plain = OmegaConf.to_container(node, resolve=False) if OmegaConf.is_config(node) else dict(node or {})
+    given = {k: plain.pop(k) for k in list(plain) if k in keys}
+    mine = [(k, v) for k, v in overrides if k.split(".")[0] in keys]
+    if given or mine:
+        check_node(where, common, typed_node(where, common, given, mine))
+    return plain, [(k, v) for k, v in overrides if k.split(".")[0] not in keys]
+
+
 def run_checks(cfg: Any) -> None:
     """The chosen plugins' cross-group checks (``Plugin.check_run``) of a validated config."""
     for group in plugins.KINDS:
@@ -226,7 +264,8 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = (), run_checks_too
             schemas.update(getattr(cls, "group_schemas", {}) or {})
         if schema is not None:
             where = f"{group}={node['name']}"
-            cfg[group] = typed_node(where, schema, node, by_group.pop(group, ()))
+            node, own = _common_keys(where, cls, schema, node, by_group.pop(group, ()))
+            cfg[group] = typed_node(where, schema, node, own)
             checks.append((where, schema, group))
     schemas.update({g: _load_class(ref) for g, ref in CORE_GROUPS.items()})
     for group, schema in schemas.items():

@@ -52,3 +52,38 @@ def test_group_of_and_plain_read_any_run_config_shape():
     assert group_of({"sim": {"name": "b"}}, "sim") == {"name": "b"}
     assert group_of(SimpleNamespace(sim=3), "sim") == 3
     assert group_of(node, "spd") is None and group_of(None, "sim") is None and plain(None) == {}
+
+
+def test_executor_workers_is_the_interface_s_key(monkeypatch):
+    """``executor.workers`` is declared by ``Executor.common_keys`` (``ExecutorKeys``): an executor
+    whose ``Config`` lacks it still composes under ``experiment=smoke`` and with the key on the
+    command line, type- and range-checked, and is built from its own keys only; one that declares
+    it keeps it."""
+    import dataclasses
+
+    from toolkit import plugins
+    from toolkit.interfaces import Executor
+
+    class Serial(Executor):
+        """One after the other."""
+
+        @dataclasses.dataclass
+        class Config:
+            name: str = "local"
+
+        def imap(self, fn, items):
+            return enumerate(map(fn, items))
+
+        def actors(self, factory, args):  # pragma: no cover - not called
+            raise NotImplementedError
+
+    real = plugins.load
+    monkeypatch.setattr(plugins, "load", lambda kind, name: Serial if kind == "executor" else real(kind, name))
+    assert "workers" not in compose(["task=zdt1", "experiment=smoke"]).executor  # the preset sets workers: 1
+    assert dict(compose(["task=zdt1", "executor.workers=3"]).executor) == {"name": "local"}
+    for bad, why in (("abc", "could not be converted to Integer"), ("-2", "a count of workers >= 0")):
+        with pytest.raises(JtError, match=why) as e:
+            compose(["task=zdt1", f"executor.workers={bad}"])
+        assert str(e.value).startswith(f"executor.workers={bad}") and "\n" not in str(e.value)
+    monkeypatch.setattr(plugins, "load", real)
+    assert compose(["task=zdt1", "executor.workers=3"]).executor.workers == 3  # executor=local declares it

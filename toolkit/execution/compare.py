@@ -52,7 +52,7 @@ def _cell(args: tuple[list[str], bool]) -> tuple[str, dict[str, float]]:
     from toolkit.execution.runner import run
 
     command = "jt run " + " ".join(overrides)  # what reruns this cell alone
-    if inner_serial:
+    if inner_serial:  # every executor's group takes workers (ExecutorKeys); 1: one at a time
         overrides = [*overrides, "executor.workers=1"]
     res = run(compose(overrides), command=command)
     return res.run_id, res.metrics

@@ -7,7 +7,7 @@ one is found through an entry point in the group named in ``toolkit.plugins.KIND
 
 from toolkit.interfaces.action import ActionSpace
 from toolkit.interfaces.curriculum import Curriculum
-from toolkit.interfaces.executor import ActorGroup, Executor
+from toolkit.interfaces.executor import ActorGroup, Executor, ExecutorKeys
 from toolkit.interfaces.plugin import Plugin
 from toolkit.interfaces.reward import RewardTerm
 from toolkit.interfaces.searcher import Param, SearchProblem, Searcher, Space
@@ -25,6 +25,7 @@ __all__ = [
     "EvalContext",
     "Evaluation",
     "Executor",
+    "ExecutorKeys",
     "Param",
     "Plugin",
     "RewardTerm",

@@ -3,9 +3,36 @@
 from __future__ import annotations
 
 import abc
-from typing import Any, Callable, Iterator, Sequence
+import dataclasses
+from typing import Any, Callable, ClassVar, Iterator, Sequence
 
 from toolkit.interfaces.plugin import Plugin
+
+
+@dataclasses.dataclass
+class ExecutorKeys:
+    """Keys of the ``executor`` group that every executor accepts, declared by the interface.
+
+    jt sets them itself (``experiment=smoke``, ``jt compare``), whichever executor is chosen. An
+    executor that acts on one declares it in its own ``Config`` (same name, type and default)
+    and reads it from there; in the group of one whose ``Config`` does not, the key is still
+    accepted and type-checked at composition, then left out of the node the executor is built
+    from: its ``Config`` stays exactly the keys it declares.
+    """
+
+    workers: int = 0
+    """How many evaluations or actors run at once. 0: the executor's own choice (the default:
+    one per core for ``executor=local``, as many as the cluster has CPUs for with ``executor=ray``,
+    always one for a serial executor); 1: one at a time, in the driver's process where the
+    executor can (``experiment=smoke``, and the runs inside a parallel ``jt compare``'s cells,
+    so that cores are not oversubscribed); N > 1: at most N at once."""
+
+    def check(self) -> None:
+        """``workers`` >= 0 (one ``JtError`` line)."""
+        from toolkit.schema import require
+
+        require(int(self.workers) >= 0, "executor.workers", self.workers,
+                "a count of workers >= 0 (0: the executor's own choice, 1: one at a time)")
 
 
 class ActorGroup(abc.ABC):
@@ -33,9 +60,20 @@ class Executor(Plugin, abc.ABC):
     workers, each with its own simulator). Every item or actor carries its own seed, so results do
     not depend on which worker ran it or in which order work finishes.
 
+    The ``executor`` group also takes the keys of ``common_keys`` (``ExecutorKeys``: ``workers``)
+    whether or not ``Config`` declares them; declare ``workers: int = 0`` in ``Config`` to act on
+    it (a parallel executor should: ``experiment=smoke`` and ``jt compare`` ask for one at a time
+    with ``workers=1``).
+
     Args:
         cfg: the ``executor`` config group, validated against ``Config``.
+
+    Attributes:
+        common_keys: the dataclass of the keys every executor's group accepts (``ExecutorKeys``);
+            read by composition (``toolkit.schema``), not meant to be overridden by a plugin.
     """
+
+    common_keys: ClassVar[type] = ExecutorKeys
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg

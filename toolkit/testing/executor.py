@@ -59,7 +59,8 @@ class Counter:
 
 class ExecutorContract:
     """Order, completeness, errors, per-actor state, ``n_workers``, ``close``; with ``executor_cls``
-    set also the plugin's ``Config``, summary, YAML and entry point."""
+    set also the plugin's ``Config``, summary, YAML, the interface's ``workers`` key and the
+    entry point."""
 
     executor_cls: ClassVar[Optional[type]] = None
     entry: ClassVar[str] = ""
@@ -157,6 +158,34 @@ class ExecutorContract:
             assert ex.map(square, [3]) == [9]
         finally:
             ex.close()
+
+    def test_workers_key_of_the_interface_composes(self):
+        """``executor.workers`` (``ExecutorKeys``, set by ``experiment=smoke`` and ``jt compare``)
+        composes for every executor: kept when its ``Config`` declares it, left out otherwise."""
+        from toolkit.config import compose
+
+        cls = self._plugin()
+        node = compose([f"executor={self.entry}", "executor.workers=1", "task=zdt1"]).executor
+        declared = {f.name for f in dataclasses.fields(cls.Config)}
+        assert (node.workers == 1) if "workers" in declared else ("workers" not in node)
+        ex = cls(node)
+        try:
+            assert ex.map(square, [3]) == [9]
+        finally:
+            ex.close()
+
+    def test_a_declared_common_key_is_the_interface_s(self):
+        """A ``Config`` field named like one of ``ExecutorKeys`` has its type and its default
+        (``workers: int = 0``, 0 meaning the executor's own choice)."""
+        def type_name(t: Any) -> str:  # a class, or its name under ``from __future__ import annotations``
+            return t.__name__ if isinstance(t, type) else str(t)
+
+        cls = self._plugin()
+        own = {f.name: f for f in dataclasses.fields(cls.Config)}
+        for f in dataclasses.fields(Executor.common_keys):
+            if f.name in own:
+                assert type_name(own[f.name].type) == type_name(f.type), (f.name, own[f.name].type)
+                assert own[f.name].default == f.default, (f.name, own[f.name].default)
 
     def test_unknown_key_is_one_clear_error(self):
         from toolkit.config import compose
