@@ -9,8 +9,9 @@ evaluated as in 002 Table 1: bounds off, up to ``eval_time_limit`` (20 s), faili
 forbidden ground contact; the metric is ``survival_s``. After every PPO iteration the start
 distribution adapts (002 §4.3, ``sampling.StartSampler``): start phases by eq 11 (on with bounds)
 and, with ``evolution``, start states from eq 12's per-segment buffers; the distribution per
-iteration is logged (``start_sampling.h5`` / ``.png``). ``mix`` gives eq 13's reward.
-docs/spacetime.md.
+iteration is logged (``start_sampling.h5`` / ``.png``). ``mix`` gives eq 13's reward. The final
+rollout also gives ``com_bounds.png`` (Fig. 5) and ``motion_vs_reference.gif`` (the policy
+beside the reference at the same clip times). docs/spacetime.md.
 """
 
 from __future__ import annotations
@@ -253,6 +254,12 @@ class SpacetimeTask(PolicyTask):
 
         info = ro["info"]
         ro["com_height"] = com_height_data(env, ro["time"], ro["com"])
+        if ro["frames"]:  # the reference at the same clip times, for motion_vs_reference.gif
+            from jt_tasks.spacetime.artifacts import reference_frames
+
+            h, w = np.asarray(ro["frames"][0]).shape[:2]
+            ro["reference_frames"] = reference_frames(env, ro["time"], w, h)
+            ro["fps"] = float(env.control_hz)
         data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))},
                 "phase": ro["com_height"]["phase"]}
         attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
@@ -284,6 +291,10 @@ class SpacetimeTask(PolicyTask):
 
             plot_com_bounds(ro["com_height"], Path(workdir) / "com_bounds.png",
                             f"{Path(str(spec.clip)).stem}: CoM height vs phase, final rollout (002 Fig. 5)")
+        if ro.get("reference_frames"):
+            from jt_tasks.spacetime.artifacts import write_motion_vs_reference
+
+            write_motion_vs_reference(workdir, ro["frames"], ro["reference_frames"], ro["fps"])
         hook = hooks.state.get("training")
         rows = hook.history() if hook is not None else np.zeros((0, 3))
         if len(rows):
@@ -305,4 +316,5 @@ class SpacetimeTask(PolicyTask):
         return Evaluation(metrics=metrics, history=history)
 
     def extra_artifacts(self, workdir: Path) -> list[str]:
-        return [n for n in ("start_sampling.h5", "start_sampling.png", "com_bounds.png") if (Path(workdir) / n).exists()]
+        names = ("start_sampling.h5", "start_sampling.png", "com_bounds.png", "motion_vs_reference.gif")
+        return [n for n in names if (Path(workdir) / n).exists()]

@@ -30,3 +30,41 @@ def test_com_height_data_puts_the_reference_start_on_the_reference_curve(tmp_pat
     assert np.ptp(d["ref_com_y"]) > 0.02  # the run's CoM bobs
     out = plot_com_bounds(d, tmp_path / "com_bounds.png")
     assert out.stat().st_size > 5000
+
+
+def test_reference_frames_pose_the_clip_in_a_second_world_with_the_envs_camera():
+    from jt_tasks.spacetime.artifacts import reference_frames
+
+    env = make_env(seed=0)
+    try:
+        env.reset(seed=0, options={"phase": 0.3})
+        q_before = env.sim.state()[0]
+        first = env.render_frame(64, 48)
+        ref = reference_frames(env, np.array([0.0, 0.2, 0.4]), 64, 48)
+        assert np.array_equal(env.sim.state()[0], q_before)  # the env's own world is untouched
+    finally:
+        env.close()
+    assert [f.shape for f in ref] == [(48, 64, 3)] * 3
+    assert np.abs(ref[0].astype(int) - first.astype(int)).mean() < 1.0  # the start is the reference state
+    assert np.abs(ref[2].astype(int) - ref[0].astype(int)).mean() > 1.0  # the reference moves
+
+
+def test_smoke_evaluation_writes_the_policy_beside_the_reference(tmp_path):
+    import imageio.v3 as iio
+    from toolkit import plugins
+    from toolkit.config import compose
+    from toolkit.interfaces.task import EvalContext
+
+    cfg = compose(["task=spacetime", "experiment=smoke"])
+    ev = plugins.load("task", "spacetime")(cfg).evaluate({}, EvalContext(index=0, seed=3, workdir=tmp_path))
+    assert "motion_vs_reference.gif" in ev.artifacts
+    both = iio.imread(tmp_path / "motion_vs_reference.gif", index=None)[..., :3].astype(int)
+    alone = iio.imread(tmp_path / "motion.gif", index=None)[..., :3].astype(int)
+    n, h, w = alone.shape[:3]  # smoke frames (64 x 48) are not enlarged
+    assert both.shape[:3] == (n, h, 2 * w + 2) and n == ev.metrics["survival_steps"] + 1  # a frame per control step
+    policy, gap, ref = both[:, :, :w], both[:, :, w:w + 2], both[:, :, w + 2:]
+    assert (gap == 255).all()
+    assert np.abs(policy - alone).mean() < 2.0  # left: the rollout (GIF palettes differ a little)
+    assert np.abs(ref[0] - policy[0]).mean() < 1.0  # both start in the reference state at eval_phase
+    steps = [np.abs(ref[i + 1] - ref[i]).mean() for i in range(n - 1)]
+    assert min(steps) > 0.1  # the reference half changes every frame
