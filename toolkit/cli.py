@@ -78,6 +78,7 @@ def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untype
 
     from toolkit.config import validate
     from toolkit.errors import JtError
+    from toolkit.execution.lifecycle import saved_config
     from toolkit.store.tracking import Store, store_root
 
     others = [o for o in overrides if not o.startswith(("resume=", "store="))]
@@ -85,11 +86,11 @@ def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untype
         raise JtError(f"resume= continues a run with its own config; drop: {' '.join(others)}")
     stores = [o.split("=", 1)[1] for o in overrides if o.startswith("store=")]
     store = Store(store_root(stores[0] if stores else None), must_exist=True)
-    store.get_run(run_id)  # one clear line if the id is unknown
-    path = store.workdir(run_id) / "config.yaml"
-    if not path.is_file() and store.is_server:  # a server store, resumed on another machine
-        store.fetch(run_id, "config.yaml", path.parent)
-    if not path.is_file():
+    run = store.get_run(run_id)  # one clear line if the id is unknown
+    path = saved_config(store, run_id, run)  # saved before the run existed: never missing after a kill
+    if path is None and store.is_server:  # a server store, resumed on another machine
+        path = store.fetch(run_id, "config.yaml", store.workdir(run_id))
+    if path is None or not path.is_file():
         raise JtError(f"run {run_id} has no saved config in {store.root}; it cannot be resumed")
     old = OmegaConf.load(path)
     old.resume = run_id

@@ -1,11 +1,13 @@
 """``jt run``: one outer MLflow run driving a searcher over a task, evaluations as nested runs.
 
-Flow: start (or reopen, for ``resume=RUN_ID``) the outer run and log config, seed, version and
-commit → build searcher and replay the saved history → loop ``ask`` → evaluate the batch through
-the executor (each point a nested run, its files logged as HDF5/PNG artifacts) → save the history
-→ ``tell`` → finally log the task's summary metrics and the search HDF5. Ctrl-C or SIGTERM ends the
-run as KILLED with the reason, an exception as FAILED; a resumed run continues from the last
-completed evaluation, and an evaluation cut off mid-way finds its own checkpoint in its workdir.
+Flow: start (or reopen, for ``resume=RUN_ID``) the outer run, owned by this process, and log config,
+seed, version and commit (``toolkit.execution.lifecycle``: the config is saved before the run's row
+exists, and a second process resuming a live run is refused) → build searcher and replay the saved
+history → loop ``ask`` → evaluate the batch through the executor (each point a nested run, its
+files logged as HDF5/PNG artifacts) → save the history → ``tell`` → finally log the task's summary
+metrics and the search HDF5. Ctrl-C or SIGTERM ends the run as KILLED with the reason, an
+exception as FAILED, a full disk in one line; a resumed run continues from the last completed
+evaluation, and an evaluation cut off mid-way finds its own checkpoint in its workdir.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import numpy as np
 
 from toolkit import plugins
 from toolkit.errors import JtError
-from toolkit.execution import describe, provenance
+from toolkit.execution import describe, lifecycle, provenance
 from toolkit.execution.evaluate import Job, run_job
 from toolkit.execution.history import History, Record
 from toolkit.execution.seeds import derive
@@ -80,52 +82,6 @@ class _Terminate:
             signal.signal(signal.SIGTERM, self._old)
 
 
-def _open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: Any,
-              nested: bool) -> tuple[str, bool]:
-    """Start a new outer run, or reopen ``cfg.resume``; returns ``(run_id, resumed)``."""
-    from toolkit.config import flatten, to_yaml
-
-    if cfg.resume:
-        run = store.get_run(str(cfg.resume))
-        if run.info.status == "FINISHED":
-            raise JtError(f"run {cfg.resume} already finished; nothing to resume")
-        store.client.update_run(run.info.run_id, status="RUNNING")
-        store.set_tags(run.info.run_id, {"jt.resumed": "true"})
-        return run.info.run_id, True
-    describe.ensure_experiment(store, experiment, task_cls)
-    tags = {
-        **describe.provenance_tags(command),
-        "jt.seed": str(cfg.seed),
-        "jt.task": str(cfg.task.name),
-        "jt.search": str(cfg.search.name),
-        describe.NOTE: describe.outer(cfg, command, nested=nested),
-    }
-    name = cfg.get("run_name") or store.unique_run_name(
-        experiment, f"{cfg.task.name}·{cfg.search.name}·seed{cfg.seed}")  # what it is, never a collision
-    run_id = store.start_run(experiment, run_name=name, tags=tags)
-    store.log_params(run_id, flatten(cfg))
-    cfg_path = store.workdir(run_id) / "config.yaml"
-    cfg_path.write_text(to_yaml(cfg))
-    store.log_artifact(run_id, cfg_path)
-    return run_id, False
-
-
-def _close_stale_children(store: Store, run_id: str, experiment: str, recorded: set[int]) -> None:
-    """Evaluations the interruption cut off (still RUNNING, or FINISHED but not yet in the saved
-    history): KILLED and renamed ``eval-NNNN·interrupted``, so the re-evaluation that follows is the
-    one ``eval-NNNN`` and no two runs share a name."""
-    runs = store.client.search_runs(
-        [store.experiment_id(experiment)],
-        filter_string=f"tags.mlflow.parentRunId = '{run_id}' and attributes.status != 'KILLED'",
-    )
-    for r in runs:
-        idx = r.data.tags.get("jt.eval_index")
-        unsaved = r.info.status == "FINISHED" and idx is not None and int(idx) not in recorded
-        if r.info.status == "RUNNING" or unsaved:
-            store.set_tags(r.info.run_id, {"mlflow.runName": f"{r.info.run_name}·interrupted"})
-            store.end_run(r.info.run_id, "KILLED", "interrupted; re-evaluated when the parent resumed")
-
-
 def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     """Run a composed, validated config (see ``toolkit.config.compose``) to completion.
 
@@ -145,47 +101,77 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     exec_cls = plugins.load("executor", str(cfg.executor.name))
     task = task_cls(cfg)
     problem = task.problem()
-    names = problem.space.names
     experiment = str(cfg.task.name)
     nested = bool(getattr(search_cls, "nested", True))
     container = OmegaConf.to_container(cfg, resolve=True)
 
     command = command or provenance.command_line()
-    run_id, resumed = _open_run(store, cfg, experiment, command, task_cls, nested)
+    with _Terminate():  # SIGTERM while opening: the run is left as it was, resumable
+        try:
+            run_id, resumed, lock = lifecycle.open_run(store, cfg, experiment, command, task_cls, nested)
+        except Exception as e:  # a full disk once the run exists: open_run says how to resume it
+            if not isinstance(e, JtError) and lifecycle.disk_full(e):
+                raise JtError(f"store={store.root}: no space left to start a run ({lifecycle.disk_full(e)}); "
+                              "free some and run it again") from e
+            raise
+        try:
+            return _drive(store, cfg, command, run_id, resumed, task, problem, search_cls, exec_cls, container,
+                          experiment, nested)
+        finally:
+            lock.release()
+
+
+def _drive(store: Store, cfg: Any, command: str, run_id: str, resumed: bool, task: Any, problem: Any,
+           search_cls: Any, exec_cls: Any, container: dict, experiment: str, nested: bool) -> RunResult:
+    """Run the opened (and locked) outer run to its end: FINISHED, KILLED or FAILED."""
+    names = problem.space.names
     workdir = store.workdir(run_id)
     hist_path = workdir / "search_history.h5"
     _log(f"jt: run {run_id} ({experiment}){' resumed' if resumed else ''}; store {store.root}")
     if cfg.get("cost"):
         _log(f"jt: cost: {cfg.cost}")
     try:
-        with _Terminate():
-            history = History.load(hist_path, names)
-            if resumed:
-                _close_stale_children(store, run_id, experiment, {r.index for r in history.records})
-            searcher = search_cls(problem, cfg.search, int(cfg.seed))
-            _replay(searcher, history, int(searcher.batch_size))
-            if resumed and len(history):
-                _log(f"jt: resumed after {len(history)} completed evaluation(s)")
-            executor = exec_cls(cfg.executor)
-            try:
-                files = _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
-                                     names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
-            finally:
-                executor.close()
-            metrics, pictures, table = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
-            pictures += files  # search=single: the evaluation's own files are on this run
-            note = describe.outer(cfg, command, metrics, getattr(task, "key_metrics", ()), pictures, nested,
-                                  describe.table(*table) if table else "")
-            store.set_tags(run_id, {describe.NOTE: note})
+        history = History.load(hist_path, names)
+        if resumed:
+            lifecycle.close_stale_children(store, run_id, experiment, {r.index for r in history.records})
+        searcher = search_cls(problem, cfg.search, int(cfg.seed))
+        _replay(searcher, history, int(searcher.batch_size))
+        if resumed and len(history):
+            _log(f"jt: resumed after {len(history)} completed evaluation(s)")
+        executor = exec_cls(cfg.executor)
+        try:
+            files = _search_loop(store, cfg, container, run_id, experiment, task, searcher, history,
+                                 names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
+        finally:
+            executor.close()
+        metrics, pictures, table = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
+        pictures += files  # search=single: the evaluation's own files are on this run
+        note = describe.outer(cfg, command, metrics, getattr(task, "key_metrics", ()), pictures, nested,
+                              describe.table(*table) if table else "")
+        store.set_tags(run_id, {describe.NOTE: note})
         store.end_run(run_id, "FINISHED")
     except KeyboardInterrupt as e:
         store.end_run(run_id, "KILLED", str(e) or "interrupted (Ctrl-C)")
         _log(f"jt: run {run_id} interrupted; continue it with: jt run resume={run_id} store={store.root}")
         raise
     except BaseException as e:
-        store.end_run(run_id, "FAILED", f"{type(e).__name__}: {e}")
+        marked = _end_failed(store, run_id, e)
+        full = lifecycle.disk_full(e)
+        if full:  # one line; the run stays resumable (RUNNING, or FAILED if that could still be written)
+            raise lifecycle.stopped_by_full_disk(run_id, store, full) from e
+        if not marked:
+            _log(f"jt: could not mark run {run_id} FAILED in the store; it still shows RUNNING")
         raise
     return RunResult(run_id, store, metrics, history.evaluations())
+
+
+def _end_failed(store: Store, run_id: str, exc: BaseException) -> bool:
+    """Mark the run FAILED with the error; False when the store cannot be written (a full disk)."""
+    try:
+        store.end_run(run_id, "FAILED", f"{type(exc).__name__}: {exc}")
+        return True
+    except Exception:  # noqa: BLE001 - the run's own error is the one to report
+        return False
 
 
 def _replay(searcher: Any, history: History, batch: int) -> None:
@@ -300,8 +286,9 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
             vals = [e.metrics[key] for e in evs if key in e.metrics and not math.isnan(e.metrics[key])]
             if vals and key not in metrics:
                 metrics[f"best_{key}"] = float(max(vals))
-    # search=single logged its evaluation on this run: a summary value of the same name is not logged twice
-    logged = set() if nested else set(store.get_run(run_id).data.metrics)
+    # search=single logged its evaluation on this run, and a run killed in here logged some already:
+    # a value of the same name is not logged twice
+    logged = set(store.get_run(run_id).data.metrics)
     with store.metrics(run_id) as buf:
         buf.add_many({k: v for k, v in metrics.items() if k not in logged})
         for key, points in curves.items():  # run-level curves: [(step, value[, unix_s]), ...]

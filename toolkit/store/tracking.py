@@ -41,9 +41,11 @@ def store_root(path: Optional[str | os.PathLike] = None) -> Path | str:
 
 
 def quiet_mlflow_logs() -> None:
-    """MLflow's and its database's INFO lines off (call after importing mlflow: it sets its own)."""
+    """MLflow's and its database's INFO lines off, and MLflow's tracebacks of database errors it then
+    raises anyway (call after importing mlflow: it sets its own levels)."""
     for name in ("alembic", "mlflow", "sqlalchemy"):
         logging.getLogger(name).setLevel(logging.WARNING)
+    logging.getLogger("mlflow.store.db.utils").setLevel(logging.CRITICAL)
 
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
