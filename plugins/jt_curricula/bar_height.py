@@ -54,13 +54,29 @@ class BarHeightCurriculum(IterationCurriculum):
         z_attr: str = "bar_height"
         """Environment attribute receiving z (jt)."""
 
+        def check(self) -> None:
+            """Finite values, dz > 0, z_min <= z_freeze <= z_max, R_T >= 0, a known signal (one
+            ``JtError`` line, at composition)."""
+            from toolkit.schema import finite, require
+
+            for key in ("z_min", "z_max", "dz", "reward_threshold", "rho_scale", "rho_offset",
+                        "control_hz_start", "control_hz_span", "c_offset_start", "c_offset_span"):
+                require(finite(getattr(self, key)), f"curriculum.{key}", getattr(self, key), "must be a finite number")
+            require(self.dz > 0, "curriculum.dz", self.dz, "must be > 0")
+            require(self.z_min >= 0, "curriculum.z_min", self.z_min, "must be >= 0")
+            require(self.z_max >= self.z_min, "curriculum.z_max", self.z_max, f"must be >= z_min = {self.z_min}")
+            if self.z_freeze is not None:
+                require(finite(self.z_freeze) and self.z_min <= self.z_freeze <= self.z_max, "curriculum.z_freeze",
+                        self.z_freeze, f"must lie in [z_min, z_max] = [{self.z_min}, {self.z_max}] (or null)")
+            require(self.reward_threshold >= 0, "curriculum.reward_threshold", self.reward_threshold, "must be >= 0")
+            require(self.control_hz_start > 0 and self.control_hz_start + self.control_hz_span > 0,
+                    "curriculum.control_hz_start", self.control_hz_start, "control rates must stay > 0")
+            require(self.signal in ("mean_return", "mean_reward"), "curriculum.signal", self.signal,
+                    "mean_return or mean_reward")
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         p = self.params
-        if not (p.dz > 0 and p.z_max >= p.z_min and p.reward_threshold >= 0):
-            raise JtError(f"{type(self).__name__}: need dz > 0, z_max >= z_min, R_T >= 0; got {p}")
-        if p.signal not in ("mean_return", "mean_reward"):
-            raise JtError(f"{type(self).__name__}: signal must be mean_return or mean_reward, got {p.signal!r}")
         self.max_level = max(0, math.ceil((p.z_max - p.z_min) / p.dz - _TOL))
         self.level = 0
         self.accumulator = 0.0

@@ -94,13 +94,13 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
 
     from toolkit.priors import auto as auto_prior
 
-    cfg = auto_prior.resolve(cfg)  # action.prior=auto: the store's own prior, trained on first use
-    store = Store(store_root(str(cfg.store)))
     task_cls = plugins.load("task", str(cfg.task.name))
     search_cls = plugins.load("search", str(cfg.search.name))
     exec_cls = plugins.load("executor", str(cfg.executor.name))
     task = task_cls(cfg)
-    problem = task.problem()
+    problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
+    cfg = auto_prior.resolve(cfg)  # action.prior=auto: the store's own prior, trained on first use
+    store = Store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)
     nested = bool(getattr(search_cls, "nested", True))
     container = OmegaConf.to_container(cfg, resolve=True)

@@ -148,6 +148,16 @@ def _find(ref: str, store_root: Optional[str], kind: str) -> Path:
                    hint=how_to_make(kind), accept=_is_prior_file).path
 
 
+def find_prior(ref: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
+    """The prior file that ``action.prior=ref`` names (a file, a folder or a run id), without
+    loading it: for checks before a run opens.
+
+    Raises:
+        JtError: one line, ending with how to make a prior.
+    """
+    return _find(str(ref).strip(), store_root, kind)
+
+
 def find_in_run(run_id: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
     """The prior file among the artifacts of MLflow run ``run_id`` (else of its nested runs).
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
@@ -105,6 +106,13 @@ class JumpConfig(PolicyConfig):
             require(finite(getattr(self, key)) and getattr(self, key) >= 0, f"task.{key}", getattr(self, key),
                     "must be a finite number >= 0")
         require(self.foot in ("left", "right"), "task.foot", self.foot, "left or right")
+        if os.path.sep not in self.clip:  # a shipped clip by name (a path is read when the env starts)
+            from toolkit.motion.skeletons import humanoid_clip_paths
+
+            names = [os.path.basename(q)[len("humanoid3d_"):-len(".txt")] for q in humanoid_clip_paths()]
+            require(self.clip in names, "task.clip", self.clip, f"one of {', '.join(names)} (or a clip file's path)")
+        else:
+            require(os.path.isfile(self.clip), "task.clip", self.clip, "no such file")
         require(self.check_every >= 1, "task.check_every", self.check_every, "must be >= 1")
         require(self.filmstrip_frames >= 0 and self.filmstrip_width > 0 and self.filmstrip_height > 0,
                 "task.filmstrip_frames/width/height", (self.filmstrip_frames, self.filmstrip_width,

@@ -41,9 +41,15 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
         raise JtError(f"task={task} needs character=humanoid ({why}), got character={character}")
     action = group_of(cfg, "action")
     name = str(group_of(action, "name") or "") if action is not None else ""
-    if name in ("pvae", "cvae") and not str(group_of(action, "prior") or "").strip():
+    prior = str(group_of(action, "prior") or "").strip() if name in ("pvae", "cvae") else ""
+    if name in ("pvae", "cvae") and not prior:
         raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
                       f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
+    if prior and prior != "auto":  # it must exist before the run opens (auto: found or trained by the runner)
+        from toolkit.priors.io import find_prior
+
+        store = group_of(cfg, "store")
+        find_prior(prior, None if store is None else str(store), name)
     trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
 
 

@@ -89,6 +89,30 @@ class SPDTrackingTask(Task):
     key_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "err_mean_dt30",
                                               "err_mean_dt600", "n_diverged")
 
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """``task.motion`` names a clip of the character (a wrong name is one line before the run
+        opens, listing the character's clips)."""
+        import os
+
+        from toolkit.config import group_of
+        from toolkit.errors import JtError
+
+        from jt_tasks.spd_tracking.motions import default_motion, motion_path
+
+        character = group_of(cfg, "character")
+        name = str(group_of(character, "name") or "humanoid") if character is not None else "humanoid"
+        motion = str(group_of(group_of(cfg, "task"), "motion") or "auto")
+        motion = default_motion(name) if motion in ("auto", "") else motion
+        if not motion or motion == "slither" or name.startswith("snake"):
+            return  # make_reference says what the snakes and unknown characters can track
+        try:
+            path = motion_path(name, motion)
+        except JtError as e:
+            raise JtError(f"task.motion={motion}: {e}") from None
+        if not os.path.isfile(path):
+            raise JtError(f"task.motion={motion}: no such file")
+
     def __init__(self, cfg: Any) -> None:
         from toolkit.config import config_of
 

@@ -38,8 +38,11 @@ def test_explicit_priors_and_raw_actions_are_left_alone(tmp_path):
 
     cfg = _cfg(tmp_path, "action=raw")
     assert auto.wants_auto(cfg) == "" and auto.resolve(cfg) is cfg
-    cfg = _cfg(tmp_path, "action.prior=somewhere/prior.h5")
-    assert auto.wants_auto(cfg) == "" and str(auto.resolve(cfg).action.prior) == "somewhere/prior.h5"
+    given = tmp_path / "somewhere" / "prior.h5"  # an explicit prior must exist at composition
+    given.parent.mkdir()
+    given.write_bytes(b"")
+    cfg = _cfg(tmp_path, f"action.prior={given}")
+    assert auto.wants_auto(cfg) == "" and str(auto.resolve(cfg).action.prior) == str(given)
     assert not (tmp_path / "mlflow.db").exists()  # nothing was looked up or trained
 
 

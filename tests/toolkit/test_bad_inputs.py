@@ -1,0 +1,46 @@
+"""User mistakes found by a probe of bad inputs: each is one ``JtError`` line at composition, before
+a prior is trained or a run opens, and no store is created (issue "Trust the store")."""
+
+from __future__ import annotations
+
+import pytest
+
+from toolkit.errors import JtError
+
+CASES = [
+    (["task=highjump", "task.clip=nope"], r"task.clip=nope: one of .*run"),
+    (["task=highjump", "task.clip=/no/such/clip.txt"], r"task.clip=/no/such/clip.txt: no such file"),
+    (["task=spd_tracking", "task.motion=nope"], r"task.motion=nope: no motion 'nope' for humanoid; choose one of"),
+    (["task=spd_tracking", "character=laikago", "task.motion=nope"], r"task.motion=nope: .*laikago; choose one of: walk"),
+    (["task=highjump", "action=pvae", "action.prior=/no/such/prior.h5"], r"action.prior=/no/such/prior.h5: no such file"),
+    (["task=highjump", "curriculum.dz=0"], r"curriculum.dz=0.0: must be > 0"),
+    (["task=highjump", "curriculum.z_min=nan"], r"curriculum.z_min=nan: must be a finite number"),
+    (["task=highjump", "curriculum.z_freeze=3"], r"curriculum.z_freeze=3.0: must lie in \[z_min, z_max\]"),
+    (["task=obstacle", "curriculum.z_max=0.01"], r"curriculum.z_max=0.01: must be >= z_min"),
+    (["task=highjump", "search=bds", "search.failures=never"], r"search.failures='never': choose one of avoid, believe"),
+]
+
+
+@pytest.mark.parametrize("overrides, message", CASES, ids=[" ".join(c[0][1:]) for c in CASES])
+def test_a_mistake_is_one_line_before_anything_runs(overrides, message, tmp_path):
+    from toolkit.config import compose
+
+    store = tmp_path / "store"
+    with pytest.raises(JtError, match=message) as e:
+        compose([*overrides, f"store={store}"])
+    assert "\n" not in str(e.value)
+    assert not store.exists()
+
+
+def test_the_task_checks_its_run_before_the_store_s_prior_is_trained(tmp_path):
+    """``action.prior=auto`` trains a prior on first use (a minute); a task mistake the task itself
+    finds (Stage 2 without its novelty reward) must come first, with nothing written."""
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    store = tmp_path / "store"
+    cfg = compose(["task=highjump", "task.stage=2", f"store={store}"])
+    assert str(cfg.action.prior) == "auto"
+    with pytest.raises(JtError, match="task.stage=2: the reward has no 'novelty' term"):
+        run(cfg)
+    assert not store.exists()
