@@ -299,6 +299,8 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = (), run_checks_too
         OmegaConf.merge(OmegaConf.structured(RunConfig), top)
     except Exception as e:  # noqa: BLE001
         raise _schema_error("config", RunConfig, e) from e
+    if "seed" in cfg and int(cfg.seed) < 0:
+        raise JtError(f"seed={cfg.seed}: must be an integer >= 0")
     if "store" in cfg and not str(cfg.store).strip():
         raise JtError("store= is empty: give a folder (store=PATH) or leave it out (./artifacts, or $JT_STORE)")
     OmegaConf.set_struct(cfg, True)

@@ -178,6 +178,14 @@ class LocalExecutor(Executor):
         start_method: str = "spawn"
         """multiprocessing start method: spawn (safe with torch/pybullet), forkserver or fork."""
 
+        def check(self) -> None:
+            """workers >= 0 and a known start method (one ``JtError`` line, at composition)."""
+            from toolkit.schema import require
+
+            require(self.workers >= 0, "executor.workers", self.workers, "a count of workers >= 0 (0: one per core)")
+            require(self.start_method in ("spawn", "forkserver", "fork"), "executor.start_method",
+                    self.start_method, "spawn, forkserver or fork")
+
     def __init__(self, cfg: Any = None) -> None:
         from toolkit.config import config_of
 

@@ -45,9 +45,21 @@ class BDSSearcher(BudgetedSearcher):
 
             """budget and batch >= 1, a known ``failures`` rule (one JtError line)."""
 
+            from jt_searchers.distances import BY_NAME
+            from toolkit.schema import require
+
             check_budget(self)
             if self.failures not in FAILURES:
                 raise JtError(f"search.failures={self.failures!r}: choose one of {', '.join(FAILURES)}")
+            require(self.n_init >= 1, "search.n_init", self.n_init, "must be >= 1")
+            require(self.n_exp >= 0 and self.n_opt >= 0 and self.n_exp + self.n_opt >= 1, "search.n_exp/n_opt",
+                    (self.n_exp, self.n_opt), "must be >= 0 with n_exp + n_opt >= 1")
+            require(self.init_method in ("uniform", "sobol"), "search.init_method", self.init_method, "uniform or sobol")
+            require(self.feature_distance is None or self.feature_distance in BY_NAME, "search.feature_distance",
+                    self.feature_distance, f"one of {', '.join(sorted(BY_NAME))} (null: the task's)")
+            for key in ("n_mc", "direct_maxfun", "lbfgs_starts"):
+                require(getattr(self, key) >= 1, f"search.{key}", getattr(self, key), "must be >= 1")
+            require(self.gp_restarts >= 0, "search.gp_restarts", self.gp_restarts, "must be >= 0")
 
         budget: int = 10
         """Total evaluations incl. initial samples; 000 §7.1.1 reports the first ten."""

@@ -27,6 +27,8 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from toolkit.errors import JtError
+
 from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.mo_cmaes import objectives_of
 from jt_searchers.random_search import unit_samples
@@ -85,7 +87,8 @@ class BSOOSearcher(BudgetedSearcher):
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
         if problem.n_objectives != 2:
-            raise ValueError("bsoo needs exactly two objectives: the binned task quantity and the cost")
+            raise JtError("search=bsoo needs a task with exactly two objectives (the binned task quantity and "
+                          "the cost), e.g. task=standing_jump")
         c = self.cfg
         self.x0 = np.clip(self.box.to_unit(problem.space.defaults()), 0.0, 1.0)
         need_range = c.bin_low is None or c.bin_high is None

@@ -46,9 +46,11 @@ class RandomSearcher(BudgetedSearcher):
 
         def check(self) -> None:
 
-            """budget and batch >= 1 (one JtError line)."""
+            """budget and batch >= 1, a known method (one JtError line)."""
+            from toolkit.schema import require
 
             check_budget(self)
+            require(self.method in ("uniform", "sobol"), "search.method", self.method, "uniform or sobol")
 
         budget: int = 10
         """Total evaluations; 000 §7.2.1 compares the first ten samples."""

@@ -18,6 +18,8 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from toolkit.errors import JtError
+
 from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
 from jt_searchers.mo_cmaes import (
     Individual,
@@ -41,9 +43,16 @@ class RMOOSearcher(BudgetedSearcher):
 
         def check(self) -> None:
 
-            """budget and batch >= 1 (one JtError line)."""
+            """budget and batch >= 1, mu >= 1, sigma0 > 0, a known success rule (one JtError line)."""
+            from toolkit.schema import finite, require
 
             check_budget(self)
+            require(self.mu >= 1, "search.mu", self.mu, "must be >= 1")
+            require(finite(self.sigma0) and self.sigma0 > 0, "search.sigma0", self.sigma0, "must be a finite number > 0")
+            require(self.max_failed >= 0 and self.max_resample_rounds >= 0 and self.patience >= 1,
+                    "search.max_failed/max_resample_rounds/patience",
+                    (self.max_failed, self.max_resample_rounds, self.patience), ">= 0, >= 0, >= 1")
+            require(self.success in SUCCESS_RULES, "search.success", self.success, f"one of {', '.join(SUCCESS_RULES)}")
 
         budget: int = 2000
         """Total evaluations (004 runs to convergence; the budget bounds a run)."""
@@ -70,11 +79,8 @@ class RMOOSearcher(BudgetedSearcher):
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
         if problem.n_objectives < 1:
-            raise ValueError("rmoo needs a task whose problem() declares n_objectives >= 1")
-        if self.cfg.mu < 1:
-            raise ValueError("rmoo needs mu >= 1")
-        if self.cfg.success not in SUCCESS_RULES:
-            raise ValueError(f"rmoo: success={self.cfg.success!r}; choose one of: {', '.join(SUCCESS_RULES)}")
+            raise JtError("search=rmoo needs a task with objectives (problem() declares n_objectives >= 1), "
+                          "e.g. task=standing_jump or task=zdt1")
         self.M = problem.n_objectives
         self.par = StrategyParameters.for_dim(self.box.dim)
         self.x0 = np.clip(self.box.to_unit(problem.space.defaults()), 0.0, 1.0)

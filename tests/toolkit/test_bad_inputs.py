@@ -18,6 +18,15 @@ CASES = [
     (["task=highjump", "curriculum.z_freeze=3"], r"curriculum.z_freeze=3.0: must lie in \[z_min, z_max\]"),
     (["task=obstacle", "curriculum.z_max=0.01"], r"curriculum.z_max=0.01: must be >= z_min"),
     (["task=highjump", "search=bds", "search.failures=never"], r"search.failures='never': choose one of avoid, believe"),
+    (["task=highjump", "search=bds", "search.n_init=0"], r"search.n_init=0: must be >= 1"),
+    (["task=highjump", "search=bds", "search.feature_distance=manhattan"], r"search.feature_distance=manhattan: one of angle"),
+    (["task=highjump", "search=bds", "search.init_method=grid"], r"search.init_method=grid: uniform or sobol"),
+    (["task=zdt1", "search=random", "search.method=grid"], r"search.method=grid: uniform or sobol"),
+    (["task=standing_jump", "search=rmoo", "search.mu=0"], r"search.mu=0: must be >= 1"),
+    (["task=standing_jump", "search=rmoo", "search.success=best"], r"search.success=best: one of parent, selected"),
+    (["task=zdt1", "seed=-1"], r"seed=-1: must be an integer >= 0"),
+    (["task=zdt1", "executor.workers=-1"], r"executor.workers=-1: a count of workers >= 0"),
+    (["task=zdt1", "executor.start_method=nope"], r"executor.start_method=nope: spawn, forkserver or fork"),
 ]
 
 
@@ -43,4 +52,15 @@ def test_the_task_checks_its_run_before_the_store_s_prior_is_trained(tmp_path):
     assert str(cfg.action.prior) == "auto"
     with pytest.raises(JtError, match="task.stage=2: the reward has no 'novelty' term"):
         run(cfg)
+    assert not store.exists()
+
+
+@pytest.mark.parametrize("search", ["rmoo", "bsoo"])
+def test_a_searcher_that_does_not_fit_the_task_is_one_line_before_anything_runs(search, tmp_path):
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    store = tmp_path / "store"
+    with pytest.raises(JtError, match=f"search={search} needs a task with"):
+        run(compose(["task=highjump", f"search={search}", f"store={store}"]))
     assert not store.exists()

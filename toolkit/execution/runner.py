@@ -99,6 +99,7 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     exec_cls = plugins.load("executor", str(cfg.executor.name))
     task = task_cls(cfg)
     problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
+    search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
     cfg = auto_prior.resolve(cfg)  # action.prior=auto: the store's own prior, trained on first use
     store = Store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from toolkit.errors import JtError
+
 from jt_searchers.bsoo import BSOOSearcher, binned_objective
 from jt_tasks.zdt import ZDT1Task
 from toolkit.testing.searcher import SearcherContract, run_batches
@@ -92,5 +94,5 @@ def test_sampled_range_spans_the_sample() -> None:
 def test_needs_two_objectives() -> None:
     from jt_tasks.strategy_landscape import StrategyLandscapeTask
 
-    with pytest.raises(ValueError, match="two objectives"):
+    with pytest.raises(JtError, match="two objectives"):
         BSOOSearcher(StrategyLandscapeTask({"task": {}}).problem(), {}, 0)

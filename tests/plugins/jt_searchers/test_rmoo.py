@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from toolkit.errors import JtError
+
 from jt_searchers.bsoo import BSOOSearcher
 from jt_searchers.mo_cmaes import Individual, StrategyParameters, update_covariance, update_step_size, step_of
 from jt_searchers.random_search import RandomSearcher
@@ -131,5 +133,5 @@ def test_success_rule_selected_counts_children_that_enter_the_parents() -> None:
         run_batches(s, task, 8, 0)
         rates[rule] = np.mean([p.p_succ for p in s.parents])
     assert rates["selected"] > rates["parent"], rates
-    with pytest.raises(ValueError, match="choose one of: parent, selected"):
+    with pytest.raises(JtError, match="search.success=better: one of parent, selected"):
         RMOOSearcher(task.problem(), {"success": "better"}, 0)
