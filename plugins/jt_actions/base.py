@@ -17,7 +17,6 @@ import numpy as np
 
 from toolkit.errors import JtError
 from toolkit.interfaces.action import ActionSpace
-from toolkit.config import config_of
 
 
 def skeleton_of(character: Any) -> Any:
@@ -61,10 +60,8 @@ class DofActionSpace(ActionSpace):
     """
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
-        params = config_of(type(self).Config, cfg)
         skeleton = skeleton_of(character)
-        super().__init__(params, skeleton)
-        self.params = params
+        super().__init__(cfg, skeleton)  # the interface validates cfg into self.params (one line on a mistake)
         self.skeleton = skeleton
 
     @property

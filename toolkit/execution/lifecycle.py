@@ -155,15 +155,47 @@ def open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: An
     except Exception:  # the insert failed, so no row names the file (an interrupt may come after it: kept)
         _staged_path(store, token).unlink(missing_ok=True)
         raise
-    lock = RunLock(store.workdir(run_id), run_id).acquire(str(store.root))  # a resume faster than us: refused here
-    try:
+    lock = None
+    try:  # from here the row exists: every failure must say how to resume it
+        lock = RunLock(store.workdir(run_id), run_id).acquire(str(store.root))  # a faster resume: refused here
         os.replace(_staged_path(store, token), store.workdir(run_id) / CONFIG_NAME)
         complete_opening(store, run_id, cfg)
     except BaseException as e:
-        lock.release()
+        if lock is not None:
+            lock.release()
         _raise_if_disk_full(e, store, run_id)
         raise
+    _sweep_staged(store)
     return run_id, False, lock
+
+
+#: staged configs older than this (s) that no run names are the leftovers of a kill before the row
+STALE_STAGED_S = 3600.0
+
+
+def _sweep_staged(store: Store) -> None:
+    """Remove staged configs (and their temp files) older than ``STALE_STAGED_S``: a process killed
+    between staging its config and creating its row left them, and no run will ever read them."""
+    import time
+
+    folder = _staged_path(store, "x").parent
+    now = time.time()
+    for f in folder.glob("*"):
+        try:
+            if not f.is_file() or now - f.stat().st_mtime <= STALE_STAGED_S:
+                continue
+            if f.suffix == ".yaml" and _named_by_a_run(store, f.stem):
+                continue  # its run was killed before it moved the file: a resume still needs it
+            f.unlink()
+        except OSError:  # another process removed or moved it first
+            continue
+
+
+def _named_by_a_run(store: Store, token: str) -> bool:
+    """Whether a run's ``jt.config_staged`` tag names the staged config ``token``."""
+    ids = [e.experiment_id for e in store.client.search_experiments()]
+    return bool(ids) and bool(store.client.search_runs(
+        ids, filter_string=f"tags.`{STAGED_TAG}` = '{token}'", max_results=1))
 
 
 def close_stale_children(store: Store, run_id: str, experiment: str, recorded: set[int]) -> None:

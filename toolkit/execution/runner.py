@@ -293,6 +293,8 @@ def _finish(store: Store, run_id: str, task: Any, searcher: Any, history: Histor
     with store.metrics(run_id) as buf:
         buf.add_many({k: v for k, v in metrics.items() if k not in logged})
         for key, points in curves.items():  # run-level curves: [(step, value[, unix_s]), ...]
+            if key in logged:  # a run killed in here logged it already
+                continue
             for step, value, when in _points(points):
                 buf.add(key, value, step, when)
     if not nested:  # the evaluations were logged on this run: report their metrics as the run's

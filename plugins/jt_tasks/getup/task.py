@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
@@ -92,7 +93,7 @@ class GetupTask(PolicyTask):
                                              p.ragdoll_kd, p.settle_max, p.rest_speed,
                                              terrain=dict(p.terrain) or None, region=region, sim_hz=p.drop_hz)
                 if cache is not None:  # written whole, then renamed: a kill never leaves half a file
-                    tmp = cache.with_suffix(".json.tmp")
+                    tmp = cache.with_name(f"{cache.name}.tmp-{os.getpid()}")  # the store's temp-file pattern
                     tmp.write_text(json.dumps(_FALLEN[key]))
                     tmp.replace(cache)
             out.extend(_FALLEN[key])

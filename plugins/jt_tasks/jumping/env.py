@@ -100,7 +100,8 @@ class JumpEnv(CharacterEnv):
         else:
             self.takeoff = takeoff_state(feats, spec.clip, spec.foot, spec.omega_y, v_y=spec.v_y)
         self._q0, self._qd0 = self._place(self.takeoff.q, self.takeoff.qd)
-        self.suite.update(centre_along=self.suite.crossing_along(self._qd0[:3]))  # the wall where the run crosses
+        if spec.suite.kind == "highjump":  # the wall where the run crosses (the bar plane is fixed)
+            self.suite.update(centre_along=self.suite.crossing_along(self._qd0[:3]))
         self.control_hz = float(spec.control_hz)
         self._pending = dict(bar_height=spec.suite.bar_height, obstacle_width=spec.suite.obstacle_width)
         self.tracker = CrossingTracker()
@@ -220,9 +221,10 @@ class JumpEnv(CharacterEnv):
         if len(smp["time"]):
             past = self.suite.past(smp["com"])
             if self.tracker.update_many(smp["time"], past, smp["root"][:, 3:7]) \
-                    and self.suite.beside(smp["com"][int(np.argmax(past >= 0.0))]):
+                    and self.suite.beside(smp["com"][self.tracker.hit_index]):
                 self.tracker.reset()  # round the end of the wall: no crossing, no feature
-                return self._finish(False, "passed beside the bar")
+                what = "bar" if self.suite.spec.kind == "highjump" else "obstacle"
+                return self._finish(False, f"passed beside the {what}")
         mat = rec["touched"].get(self.suite.mat_id)
         if mat is not None and not self.landed:
             self.landed, self.head_first = True, HEAD_LINK in mat

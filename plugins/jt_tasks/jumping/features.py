@@ -103,7 +103,8 @@ class CrossingTracker:
     def update_many(self, times: np.ndarray, signed_distances: np.ndarray, q_roots: np.ndarray) -> bool:
         """``update`` for each row, in order, in one call: ``times`` ``(k,)``, ``signed_distances``
         ``(k,)``, ``q_roots`` ``(k, 4)``. Equivalent to the loop, but only the rows around the first
-        crossing are looked at one by one. True when the crossing was found in these rows."""
+        crossing are looked at one by one. True when the crossing was found in these rows; its row
+        is then ``hit_index``."""
         k = len(times)
         if k == 0:
             return False
@@ -117,6 +118,7 @@ class CrossingTracker:
             self._prev = (float(times[-1]), float(d[-1]), np.asarray(q_roots[-1], dtype=float).copy())
             return False
         i = int(hits[0])
+        self.hit_index = i
         if i > 0:
             self._prev = (float(times[i - 1]), float(d[i - 1]), np.asarray(q_roots[i - 1], dtype=float).copy())
         self.update(float(times[i]), float(d[i]), q_roots[i])
