@@ -224,7 +224,18 @@ def _common_keys(where: str, cls: type, schema: type, node: Any,
 
 
 def run_checks(cfg: Any) -> None:
-    """The chosen plugins' cross-group checks (``Plugin.check_run``) of a validated config."""
+    """The chosen plugins' cross-group checks (``Plugin.check_run``) of a validated config, and
+    no group chosen that the task never reads (``Task.ignores_groups``)."""
+    task = cfg.get("task")
+    if task is not None and "name" in task:
+        ignored = getattr(plugins.load("task", str(task["name"])), "ignores_groups", ())
+        chosen = [g for g in ignored if cfg.get(g) is not None]
+        if chosen:
+            g = chosen[0]
+            what = cfg[g].get("name", "") if hasattr(cfg[g], "get") else ""
+            article = "an" if g[0] in "aeiou" else "a"
+            drop = f"{g}={what}" if what else f"the {g}= choice"
+            raise JtError(f"task={task['name']} does not read {article} {g} group; drop {drop} (it would be ignored)")
     for group in plugins.KINDS:
         node = cfg.get(group)
         if node is not None and "name" in node and group != "reward":

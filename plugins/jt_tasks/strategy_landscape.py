@@ -31,6 +31,8 @@ from toolkit.errors import JtError
 class StrategyLandscapeTask(Task):
     """Synthetic box of hidden strategy cells (unequal sizes) with plateau features + noise."""
 
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+
     key_metrics: ClassVar[tuple[str, ...]] = ("distinct_at_10", "distinct_strategies")
 
     @dataclasses.dataclass

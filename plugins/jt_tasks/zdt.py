@@ -57,6 +57,8 @@ def hypervolume(F: np.ndarray, ref: Sequence[float]) -> float:
 class ZDT1Task(Task):
     """ZDT1 bi-objective benchmark with its exact front hypervolume."""
 
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+
     key_metrics: ClassVar[tuple[str, ...]] = ("hv_ratio", "hypervolume")
 
     @dataclasses.dataclass

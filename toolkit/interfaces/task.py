@@ -81,6 +81,9 @@ class Task(Plugin, abc.ABC):
             differ between runs by nature and are left out of same-seed checks.
         curve_prefix: where an evaluation's ``history`` curves go in MLflow (``train/``: the chart
             section "train", ``train/mean_return`` beside the final ``mean_return``).
+        ignores_groups: the optional groups (``action``, ``reward``, ``curriculum``) this task
+            never reads; choosing one of them for it is refused at composition, in one line,
+            instead of being silently ignored. Empty by default (a task may read any group).
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
@@ -89,6 +92,7 @@ class Task(Plugin, abc.ABC):
     key_metrics: ClassVar[tuple[str, ...]] = ()
     timing_metrics: ClassVar[tuple[str, ...]] = ()
     curve_prefix: ClassVar[str] = "train/"
+    ignores_groups: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg

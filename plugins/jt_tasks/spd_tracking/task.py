@@ -82,6 +82,8 @@ class SPDTrackingConfig:
 class SPDTrackingTask(Task):
     """Mocap tracking with SPD and a hand-of-God root over time steps: error, FPS, SPD share."""
 
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+
     Config: ClassVar[type] = SPDTrackingConfig
     timing_metrics: ClassVar[tuple[str, ...]] = ("fps", "spd_share_pct", "step_us", "spd_us")
     curve_prefix: ClassVar[str] = "tracking/"

@@ -34,6 +34,8 @@ def _spd_group(cfg: Any) -> dict:
 class StandingJumpTask(Task):
     """Standing jump of a planar humanoid: jump height vs effort, natural and supernatural (004)."""
 
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+
     key_metrics: ClassVar[tuple[str, ...]] = ("hypervolume", "max_natural_height", "max_height", "n_front")
 
     @dataclasses.dataclass
