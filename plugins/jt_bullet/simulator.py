@@ -119,6 +119,25 @@ class BulletSimulator(SceneQueries, Simulator):
 
     # ------------------------------------------------------------------ characters
     @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """Per-joint overrides (``character.joint_kp`` / ``joint_kd`` / ``joint_torque_limit``) name
+        joints the character has: checked at composition by loading it once in a private DIRECT
+        client (~0.2 s, only when such a table is given), one line listing the joints otherwise."""
+        cc = CharacterConfig.from_node(_get(cfg, "character"))
+        if not (cc.joint_kp or cc.joint_kd or cc.joint_torque_limit):
+            return
+        from toolkit.quiet import native_stderr_silenced
+
+        with native_stderr_silenced():  # PyBullet's import banner, printed from C
+            import pybullet as pb
+
+            client = pb.connect(pb.DIRECT)
+        try:
+            cls.load_character(cc, client)
+        finally:
+            pb.disconnect(client)
+
+    @classmethod
     def load_character(cls, name: Any, client: Any, **kw: Any) -> Any:
         """Load a character into ``client`` with a ``CharacterConfig``'s gain overrides applied.
 

@@ -21,10 +21,16 @@ class PCGBackend(ToolkitSPD):
         max_iter_factor: int = 20
         """Iteration cap = max_iter_factor * n_dof."""
 
+        def check(self) -> None:
+            """tol a finite number > 0, max_iter_factor >= 1 (one ``JtError`` line, at composition)."""
+            from toolkit.schema import finite, require
+
+            require(finite(self.tol) and self.tol > 0, "spd.tol", self.tol, "must be a finite number > 0")
+            require(self.max_iter_factor >= 1, "spd.max_iter_factor", self.max_iter_factor, "must be >= 1")
+
     def _setup(self) -> None:
-        cfg = self.params_of(self.cfg)
-        self.tol = float(cfg.get("tol", 1e-12))
-        self.max_iter_factor = int(cfg.get("max_iter_factor", 20))
+        self.tol = float(self.params.tol)
+        self.max_iter_factor = int(self.params.max_iter_factor)
 
     def torques(self, q, qd, q_target, kp, kd, dt, qd_target=None, tau_ext=None):  # noqa: D102
         from toolkit.dynamics.spd import spd_system_kernel, _PCG

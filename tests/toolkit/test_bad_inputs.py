@@ -27,6 +27,8 @@ CASES = [
     (["task=zdt1", "seed=-1"], r"seed=-1: must be an integer >= 0"),
     (["task=zdt1", "executor.workers=-1"], r"executor.workers=-1: a count of workers >= 0"),
     (["task=zdt1", "executor.start_method=nope"], r"executor.start_method=nope: spawn, forkserver or fork"),
+    (["task=spd_tracking", "spd=pcg", "spd.tol=-1"], r"spd.tol=-1.0: must be a finite number > 0"),
+    (["task=highjump", "character.joint_kp={nope: 150.0}"], r"character 'humanoid' has no movable joint 'nope'; joints: chest"),
     (["task=zdt1", "reward=highjump"], r"task=zdt1 does not read a reward group; drop the reward= choice"),
     (["task=standing_jump", "action=pvae"], r"task=standing_jump does not read an action group; drop action=pvae"),
 ]
