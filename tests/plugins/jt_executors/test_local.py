@@ -110,6 +110,17 @@ def _kill9_leaves_no_worker(proc: subprocess.Popen, n_workers: int, ready_s: flo
     return left
 
 
+def _assert_kill9_leaves_no_worker(cmd: list, **popen) -> None:
+    """Start ``cmd``, wait for its two workers, SIGKILL it: none of its processes may survive."""
+    proc = subprocess.Popen(cmd, **popen)
+    try:
+        assert _kill9_leaves_no_worker(proc, 2) == set()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
 @linux_proc
 def test_kill9_of_a_jt_run_leaves_no_pool_worker(example_plugin_dir, tmp_path):
     """A real ``jt run ... executor.workers=2`` (evaluations of 30 s, so both pool workers are busy)
@@ -118,14 +129,8 @@ def test_kill9_of_a_jt_run_leaves_no_pool_worker(example_plugin_dir, tmp_path):
 
     args = ["task=quadratic", "task.sleep=30", "search=random", "search.budget=4", "search.batch=2",
             "executor=local", "executor.workers=2", f"store={tmp_path / 'store'}"]
-    proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", *args], env=jt_env(example_plugin_dir),
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=tmp_path)
-    try:
-        assert _kill9_leaves_no_worker(proc, 2) == set()
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    _assert_kill9_leaves_no_worker([sys.executable, "-m", "toolkit.cli", "run", *args], env=jt_env(example_plugin_dir),
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=tmp_path)
 
 
 ACTORS_DRIVER = """
@@ -139,14 +144,8 @@ LocalExecutor({"name": "local", "workers": 2}).actors(time.sleep, [(600,), (600,
 def test_kill9_of_a_driver_leaves_no_actor(tmp_path):
     """Two actor processes of ``executor=local``, busy (building their object for 10 minutes, so
     not reading their pipe), end when their driver is killed with SIGKILL."""
-    proc = subprocess.Popen([sys.executable, "-c", ACTORS_DRIVER], cwd=tmp_path,
-                            env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
-    try:
-        assert _kill9_leaves_no_worker(proc, 2) == set()
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    _assert_kill9_leaves_no_worker([sys.executable, "-c", ACTORS_DRIVER], cwd=tmp_path,
+                                   env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
 
 
 def test_the_watchdog_alone_ends_an_orphan(tmp_path):
@@ -158,11 +157,12 @@ def test_the_watchdog_alone_ends_an_orphan(tmp_path):
         "from jt_executors import local\n"
         "if sys.argv[1] == 'parent':\n"
         "    import subprocess\n"
-        "    child = subprocess.Popen([sys.executable, __file__, 'child', str(os.getpid())])\n"
+        "    child = subprocess.Popen([sys.executable, __file__, 'child', str(os.getpid())], stdout=subprocess.PIPE)\n"
+        "    assert child.stdout.readline().strip() == b'armed'\n"  # the parent dies only once the guard runs
         "    print(child.pid, flush=True)\n"
-        "    time.sleep(2)\n"
         "    os._exit(0)\n"
         "local._die_with_parent(int(sys.argv[2]), pdeathsig=False)\n"
+        "print('armed', flush=True)\n"
         "time.sleep(600)\n")
     proc = subprocess.run([sys.executable, str(script), "parent"], capture_output=True, text=True, timeout=60,
                           env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
