@@ -78,6 +78,40 @@ def check_budget(cfg: Any) -> None:
             raise JtError(f"search.{key}={value}: must be a whole number >= 1")
 
 
+def feasible_mask(problem: SearchProblem, box: UnitBox, u: np.ndarray) -> np.ndarray:
+    """Whether unit points ``u`` ``(n, dim)`` satisfy ``problem.constraint`` ``(n,)`` (all True without one)."""
+    u = np.atleast_2d(np.asarray(u, dtype=float)).reshape(-1, box.dim)
+    if problem.constraint is None:
+        return np.ones(len(u), dtype=bool)
+    margins = np.asarray(problem.constraint(box.from_unit(u)), dtype=float).reshape(len(u))
+    return margins >= 0.0
+
+
+def feasible_samples(problem: SearchProblem, box: UnitBox, n: int, seed: int, method: str = "uniform") -> np.ndarray:
+    """``n`` seeded unit points ``(n, dim)`` within ``problem.constraint``.
+
+    Without a constraint exactly ``unit_samples(n, dim, seed, method)``. With one, the first ``n``
+    feasible points of that design continued (rejection sampling: later rounds draw ``64 n`` more
+    points from seeds derived from ``seed``), so the points are a deterministic function of the
+    arguments; a constraint that leaves no feasible point in ``20 x 64 n`` draws is one ``JtError``.
+    """
+    from jt_searchers.random_search import unit_samples
+
+    u = unit_samples(n, box.dim, seed, method)
+    if problem.constraint is None or n == 0:
+        return u
+    kept = u[feasible_mask(problem, box, u)]
+    for k in range(1, 21):
+        if len(kept) >= n:
+            break
+        more = unit_samples(64 * n, box.dim, seed_int(seed, 7919, k), method)
+        kept = np.vstack([kept, more[feasible_mask(problem, box, more)]])
+    if len(kept) < n:
+        raise JtError(f"{problem.constraint_name or 'the task constraint'} leaves (almost) no point of the search box: "
+                      "widen the box (task.ranges) or relax the constraint")
+    return kept[:n]
+
+
 class BudgetedSearcher(Searcher):
     """A searcher with a total evaluation budget and FIFO matching of told to asked points.
 

@@ -23,12 +23,11 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from jt_searchers.acquisition import ExpectedDiversity, Exploration
-from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
+from jt_searchers.base import BudgetedSearcher, check_budget, feasible_mask, feasible_samples, seed_int
 from jt_searchers.distances import resolve
-from jt_searchers.feasibility import feasibility
+from jt_searchers.feasibility import KnownConstraint, combine, feasibility
 from jt_searchers.gp import FeatureGP
 from jt_searchers.optimize import maximize_direct, maximize_lbfgsb
-from jt_searchers.random_search import unit_samples
 from toolkit.errors import JtError
 
 KINDS = ("init", "explore", "diversity")
@@ -36,7 +35,12 @@ FAILURES = ("avoid", "believe")
 
 
 class BDSSearcher(BudgetedSearcher):
-    """Bayesian Diversity Search: GP surrogate of features, alternating exploration / diversity picks."""
+    """Bayesian Diversity Search: GP surrogate of features, alternating exploration / diversity picks.
+
+    A known constraint of the problem (``SearchProblem.constraint``) is kept: the initial samples
+    are drawn within it and both acquisitions are zero outside it (``KnownConstraint``)."""
+
+    honours_constraint = True
 
     @dataclasses.dataclass
     class Config:
@@ -102,7 +106,8 @@ class BDSSearcher(BudgetedSearcher):
         self._centre = 0.5 * (low + high)  # prior mean = centre of the feature range (000 §6.1.5)
         self._half = np.where(half > 0, half, 1.0)
         self._distance = resolve(c.feature_distance or problem.feature_distance)
-        self._init = unit_samples(c.n_init, self.box.dim, seed_int(seed, 0), c.init_method)
+        self._init = feasible_samples(problem, self.box, c.n_init, seed_int(seed, 0), c.init_method)
+        self._known = KnownConstraint(problem, self.box) if problem.constraint is not None else None
         self._z = np.random.default_rng(seed_int(seed, 1)).standard_normal((c.n_mc, m))
         self._gp = FeatureGP(self.box.dim, self._centre, self._half)
         self._fitted_at = -1  # n_told when the hyperparameters were last learned
@@ -152,27 +157,51 @@ class BDSSearcher(BudgetedSearcher):
     # ---- picks ----------------------------------------------------------------------------------
 
     def _feasibility(self) -> Any:
-        """``p(feature | x)`` from the told outcomes (``failures="avoid"`` and a failure told), else None."""
-        if self.cfg.failures != "avoid":
-            return None
-        U, _, ok = self._observed()
-        return feasibility(U, ok, self._gp.lengthscales)
+        """The weight of both acquisitions: ``p(feature | x)`` from the told outcomes
+        (``failures="avoid"`` and a failure told) times the known constraint's indicator; None
+        when neither applies (Alg. 1 unchanged)."""
+        learned = None
+        if self.cfg.failures == "avoid":
+            U, _, ok = self._observed()
+            learned = feasibility(U, ok, self._gp.lengthscales)
+        return combine(learned, self._known)
+
+    def _candidates(self, j: int, kind: int) -> tuple[np.ndarray, np.random.Generator]:
+        """512 seeded unit candidates ``(n, dim)`` for pick ``j`` (the feasible ones, with a constraint)."""
+        rng = np.random.default_rng(seed_int(self.seed, kind, j))
+        cand = rng.random((512, self.box.dim))
+        if self._known is not None:
+            cand = cand[feasible_mask(self.problem, self.box, cand)]
+            if len(cand) == 0:
+                cand = feasible_samples(self.problem, self.box, 64, seed_int(self.seed, kind, j, 1))
+        return cand, rng
 
     def _explore(self, gp: FeatureGP, j: int, feasible: Any = None) -> tuple[np.ndarray, float]:
         """argmax sigma (eq 9) by L-BFGS-B from the best of 512 seeded candidates + random starts."""
         acq = Exploration(gp, feasible)
-        rng = np.random.default_rng(seed_int(self.seed, 3, j))
-        cand = rng.random((512, self.box.dim))
+        cand, rng = self._candidates(j, 3)
         vals = acq(cand)
         order = np.argsort(-vals, kind="stable")
-        others = rng.choice(order[1:], self.cfg.lbfgs_starts - 1, replace=False)
+        others = rng.choice(order[1:], min(self.cfg.lbfgs_starts - 1, len(order) - 1), replace=False)
         starts = cand[np.concatenate([order[:1], others])]
-        return maximize_lbfgsb(acq.value_and_grad, starts)
+        u, v = maximize_lbfgsb(acq.value_and_grad, starts)
+        return self._keep_feasible(u, v, cand, vals)
 
-    def _diversify(self, gp: FeatureGP, observed: np.ndarray, feasible: Any = None) -> tuple[np.ndarray, float]:
+    def _diversify(self, gp: FeatureGP, observed: np.ndarray, j: int, feasible: Any = None) -> tuple[np.ndarray, float]:
         """argmax of the MC expected minimum feature distance (eq 7) by DIRECT."""
         acq = ExpectedDiversity(gp, observed, self._distance, self._z, feasible)
-        return maximize_direct(acq.scalar(), self.box.dim, maxfun=self.cfg.direct_maxfun)
+        u, v = maximize_direct(acq.scalar(), self.box.dim, maxfun=self.cfg.direct_maxfun)
+        if self._known is None or feasible_mask(self.problem, self.box, u[None])[0]:
+            return u, v
+        cand, _ = self._candidates(j, 4)
+        return self._keep_feasible(u, v, cand, acq(cand))
+
+    def _keep_feasible(self, u: np.ndarray, v: float, cand: np.ndarray, vals: np.ndarray) -> tuple[np.ndarray, float]:
+        """``(u, v)`` when ``u`` meets the known constraint (or there is none), else the best candidate."""
+        if self._known is None or feasible_mask(self.problem, self.box, u[None])[0]:
+            return u, v
+        i = int(np.argmax(vals))
+        return cand[i], float(vals[i])
 
     def _propose(self, k: int) -> np.ndarray:
         c = self.cfg
@@ -191,7 +220,7 @@ class BDSSearcher(BudgetedSearcher):
                 u, v = self._explore(gp, j, feasible)
                 self.kinds.append("explore")
             else:
-                u, v = self._diversify(gp, observed, feasible)
+                u, v = self._diversify(gp, observed, j, feasible)
                 self.kinds.append("diversity")
             self.acq.append(v)
             self._n_model_picks += 1

@@ -12,11 +12,15 @@ the acquisition by the probability of feasibility under a second GP: here a GP o
 
 so a failed point's neighbourhood (mu ~ -1, sigma small) gets p ~ 0, unexplored space p = 1/2 and
 the neighbourhood of successes p -> 1.
+
+A *known* constraint of the problem (``SearchProblem.constraint``, e.g. the high jump's take-off
+states whose run-up cannot reach the bar plane in flight) is no probability: ``KnownConstraint``
+weighs infeasible points 0, feasible ones 1, and ``combine`` multiplies it with the learned model.
 """
 
 from __future__ import annotations
 
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 from scipy.stats import norm
@@ -67,3 +71,57 @@ def feasibility(U: np.ndarray, ok: np.ndarray, lengthscales: np.ndarray) -> Opti
     if ok.all():
         return None
     return Feasibility(U, ok, lengthscales)
+
+
+class KnownConstraint:
+    """Indicator of ``SearchProblem.constraint`` on unit points (1 feasible, 0 not; gradient 0).
+
+    Args:
+        problem: the search problem (its ``constraint``).
+        box: the unit-cube map of its space.
+    """
+
+    def __init__(self, problem: Any, box: Any) -> None:
+        self.problem, self.box = problem, box
+
+    def __call__(self, U: np.ndarray) -> np.ndarray:
+        """``1[x feasible]`` at unit points ``U`` ``(n, dim)`` → ``(n,)``."""
+        from jt_searchers.base import feasible_mask
+
+        return feasible_mask(self.problem, self.box, U).astype(float)
+
+    def value_and_grad(self, u: np.ndarray) -> tuple[float, np.ndarray]:
+        """The indicator at one unit point ``u`` ``(dim,)`` and a zero gradient ``(dim,)``."""
+        u = np.asarray(u, dtype=float).reshape(-1)
+        return float(self(u[None])[0]), np.zeros_like(u)
+
+
+class Product:
+    """Product of weight models (``Feasibility``, ``KnownConstraint``) with the same interface."""
+
+    def __init__(self, *models: Any) -> None:
+        self.models = [m for m in models if m is not None]
+
+    def __call__(self, U: np.ndarray) -> np.ndarray:
+        """Product of the models at unit points ``U`` ``(n, dim)`` → ``(n,)``."""
+        out = np.ones(len(np.atleast_2d(U)))
+        for m in self.models:
+            out = out * m(U)
+        return out
+
+    def value_and_grad(self, u: np.ndarray) -> tuple[float, np.ndarray]:
+        """Product and its gradient ``(dim,)`` at one unit point ``u`` ``(dim,)`` (product rule)."""
+        parts = [m.value_and_grad(u) for m in self.models]
+        value = float(np.prod([v for v, _ in parts]))
+        grad = np.zeros(len(np.asarray(u).reshape(-1)))
+        for i, (_, g) in enumerate(parts):
+            grad = grad + np.asarray(g) * float(np.prod([v for j, (v, _) in enumerate(parts) if j != i]))
+        return value, grad
+
+
+def combine(*models: Any) -> Any:
+    """The product of the models that are not ``None``: ``None`` when none is, the model itself when one is."""
+    kept = [m for m in models if m is not None]
+    if not kept:
+        return None
+    return kept[0] if len(kept) == 1 else Product(*kept)

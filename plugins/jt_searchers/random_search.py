@@ -39,7 +39,10 @@ def unit_samples(n: int, dim: int, seed: int, method: str = "uniform") -> np.nda
 
 
 class RandomSearcher(BudgetedSearcher):
-    """Uniform (or scrambled-Sobol) random samples of the box, seeded."""
+    """Uniform (or scrambled-Sobol) random samples of the box, seeded; within the problem's
+    constraint when it has one (rejection sampling, ``base.feasible_samples``)."""
+
+    honours_constraint = True
 
     @dataclasses.dataclass
     class Config:
@@ -62,7 +65,9 @@ class RandomSearcher(BudgetedSearcher):
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
         # The whole design is drawn up front, so the points never depend on how asks are batched.
-        self._design = unit_samples(self.budget, self.box.dim, seed, self.cfg.method)
+        from jt_searchers.base import feasible_samples
+
+        self._design = feasible_samples(problem, self.box, self.budget, seed, self.cfg.method)
 
     def _propose(self, k: int) -> np.ndarray:
         return self._design[self.n_asked : self.n_asked + k]

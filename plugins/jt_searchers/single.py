@@ -18,6 +18,8 @@ class SingleSearcher(Searcher):
 
     #: the evaluation is logged on the outer run (no nested child run)
     nested = False
+    #: the one point is the user's (or the task's default): a constraint of the box does not apply
+    honours_constraint = True
 
     @dataclasses.dataclass
     class Config:

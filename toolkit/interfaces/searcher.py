@@ -82,6 +82,11 @@ class SearchProblem:
         objective_names: names of the objectives, for tables and plots.
         reference_point: hypervolume reference point ``(n_objectives,)`` (worse than any sample).
         distinct_threshold: two features closer than this count as the same strategy.
+        constraint: a known constraint on the box, ``X (n, dim) -> margins (n,)``: a point is
+            feasible where its margin is >= 0 (e.g. the high jump's take-off states whose run-up
+            reaches the bar plane in flight). Searchers with ``honours_constraint`` propose only
+            feasible points; the others refuse a constrained problem. ``None``: the whole box.
+        constraint_name: what the constraint is, for messages (e.g. ``task.max_time_to_bar=0.5``).
     """
 
     space: Space
@@ -93,6 +98,8 @@ class SearchProblem:
     objective_names: Sequence[str] = ()
     reference_point: Optional[Sequence[float]] = None
     distinct_threshold: Optional[float] = None
+    constraint: Optional[Callable[[Any], Any]] = None
+    constraint_name: str = ""
 
 
 class Searcher(Plugin, abc.ABC):
@@ -111,6 +118,9 @@ class Searcher(Plugin, abc.ABC):
     Attributes:
         nested: True (default): each evaluation is a nested MLflow run under the outer run;
             False: the one evaluation is logged on the outer run itself (``search=single``).
+        honours_constraint: True when the searcher proposes only points within
+            ``SearchProblem.constraint``; a searcher that does not (the default) refuses a
+            constrained problem in one line rather than silently sampling outside it.
 
     Args:
         problem: what to search.
@@ -119,8 +129,16 @@ class Searcher(Plugin, abc.ABC):
     """
 
     nested: ClassVar[bool] = True
+    honours_constraint: ClassVar[bool] = False
 
     def __init__(self, problem: SearchProblem, cfg: Any, seed: int) -> None:
+        if problem.constraint is not None and not type(self).honours_constraint:
+            from toolkit.errors import JtError
+
+            name = getattr(type(self), "name", "") or type(self).__name__
+            raise JtError(f"search={name} cannot keep to the task's constraint "
+                          f"({problem.constraint_name or 'SearchProblem.constraint'}): unset it or use a searcher "
+                          "that honours it (search=bds, search=random)")
         self.problem = problem
         self.cfg = cfg
         self.seed = seed

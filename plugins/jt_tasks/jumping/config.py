@@ -45,6 +45,11 @@ class JumpConfig(PolicyConfig):
     clip's take-off frame with the features imposed (docs/highjump.md)."""
     distance: float = 0.9
     """m from the take-off root to the bar plane / obstacle (ours)."""
+    max_time_to_bar: Optional[float] = None
+    """s, high jump only: search only take-off states whose horizontal root velocity carries the
+    root to the bar plane within this time (``distance / v_n <= t``, ``v_n`` the speed along the
+    bar's normal, set by alpha and v_z): a known constraint every searcher keeps to (ours; 000 gives
+    no search box; docs/highjump.md "The laptop run"). null: the whole box (the paper)."""
     obstacle_height: float = 0.5
     """m, the obstacle jump's box (000 §6.1: 50 cm); unused by the high jump; 0: the long jump."""
     mat_height: float = 0.3
@@ -84,6 +89,8 @@ class JumpConfig(PolicyConfig):
         for key in ("distance", "time_limit", "distinct_threshold"):
             require(finite(getattr(self, key)) and getattr(self, key) > 0, f"task.{key}", getattr(self, key),
                     "must be a finite number > 0")
+        require(self.max_time_to_bar is None or (finite(self.max_time_to_bar) and self.max_time_to_bar > 0),
+                "task.max_time_to_bar", self.max_time_to_bar, "must be a number of seconds > 0 (or null: no constraint)")
         for key in ("obstacle_height", "mat_height", "safe_margin"):
             require(finite(getattr(self, key)) and getattr(self, key) >= 0, f"task.{key}", getattr(self, key),
                     "must be a finite number >= 0")

@@ -114,8 +114,23 @@ class JumpTask(PolicyTask):
                 raise JtError("task.stage=2 trains one policy from task.init: use search=single (the default)")
         names = [n for n in self.feature_names if n not in self._fixed()]
         space = Space(tuple(Param(n, r[n][0], r[n][1], d.get(n)) for n in names))
+        constraint = self.reach_constraint(names)
         return SearchProblem(space=space, n_features=1, feature_low=[0.0], feature_high=[math.pi],
-                             feature_distance=angle_distance, distinct_threshold=self.params.distinct_threshold)
+                             feature_distance=angle_distance, distinct_threshold=self.params.distinct_threshold,
+                             constraint=constraint,
+                             constraint_name=f"task.max_time_to_bar={self.params.max_time_to_bar}" if constraint else "")
+
+    def reach_constraint(self, names: list[str]) -> Any:
+        """``task.max_time_to_bar`` as a known constraint of the box (``BarReach``), or None.
+
+        None unless the task is a high jump, the time is set and alpha or v_z is searched (the
+        others do not change the speed towards the bar)."""
+        t_max = self.params.max_time_to_bar
+        if self.kind != "highjump" or t_max is None or not {"alpha", "v_z"} & set(names):
+            return None
+        from jt_tasks.jumping.reach import BarReach
+
+        return BarReach.of_task(self, names, float(t_max))
 
     # ------------------------------------------------------------------ building blocks
     def env_spec(self, point: dict[str, float]) -> Any:
