@@ -146,7 +146,8 @@ def check(root: Path, port: Any, env: Optional[Mapping[str, str]] = None) -> Non
 
 
 def serve(root: Path, port: int) -> int:
-    """Run the UI for the store at ``root`` until Ctrl-C or SIGTERM (which stop the server too).
+    """Run the UI for the store at ``root`` until Ctrl-C or SIGTERM (which stop the server too;
+    so does a ``kill -9`` of jt, through ``toolkit.store.ui_guard``).
 
     A store that has no database yet is created first (through ``Store``: the schema, MLflow's
     "Default" experiment inside the store); an existing one is served without importing MLflow
@@ -164,9 +165,11 @@ def serve(root: Path, port: int) -> int:
 
         Store(root)
     cmd, env = command(root, port)
-    # its own process group: stopping jt stops MLflow's server process and its worker together,
-    # also where a shell started jt in the background (SIGINT ignored there)
-    proc = subprocess.Popen(cmd, env=env, start_new_session=True)
+    # its own process group, led by the guard (toolkit.store.ui_guard): stopping jt stops MLflow's
+    # server process and its worker together, also where a shell started jt in the background
+    # (SIGINT ignored there), and the guard stops them when jt dies without a word (kill -9)
+    guard = [sys.executable, "-m", "toolkit.store.ui_guard", str(os.getpid()), *cmd]
+    proc = subprocess.Popen(guard, env=env, start_new_session=True)
 
     def stop(signum: int, frame: Any) -> None:
         raise KeyboardInterrupt

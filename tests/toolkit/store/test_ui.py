@@ -191,6 +191,46 @@ def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
             proc.wait()
 
 
+def test_kill_9_of_jt_ui_stops_the_server_tree(tmp_path):
+    """``kill -9`` of ``jt ui`` runs no handler of jt's: the guard in the server's group notices
+    that jt is gone and ends the server and its worker (issue 15: the server used to keep the port)."""
+    import sqlite3
+
+    from toolkit.store import ui_guard
+
+    root = tmp_path / "s"
+    root.mkdir()
+    sqlite3.connect(root / "mlflow.db").execute("create table t (x)").connection.close()
+    proc = subprocess.Popen([sys.executable, "-c", FAKE_UI, str(root), str(free_port())], env=jt_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
+            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate(timeout=10)
+            time.sleep(0.1)
+        pids = [int(p) for p in (root / "pids").read_text().split()]
+        guard = [k for k in _children(proc.pid) if "ui_guard" in k[2]]
+        assert len(guard) == 1, _children(proc.pid)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5 * ui_guard.PERIOD_S + 10
+        alive = lambda: [p for p in pids + [int(guard[0][0])] if os.path.exists(f"/proc/{p}") and "Z" not in _state(p)]
+        while alive() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not alive(), "the server outlived a kill -9 of jt ui"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_the_guard_passes_the_servers_exit_status_on():
+    from toolkit.store.ui_guard import main
+
+    assert main([str(os.getpid()), sys.executable, "-c", "raise SystemExit(3)"]) == 3
+    assert main(["nope", "x"]) == 2
+
+
 def _state(pid):
     try:
         return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0]
