@@ -9,7 +9,9 @@ resume finishes the opening (``complete_opening``).
 
 A run is driven by one process at a time: ``open_run`` takes the run's lock
 (``toolkit.execution.lock``) before it changes anything, so a second ``resume=`` of a run that a
-live process drives is refused in one line, and a dead owner (``kill -9``) blocks nothing.
+live process drives is refused in one line, and a dead owner (``kill -9``) blocks nothing. On a
+server store, whose working folders are per machine, the owner also beats a heartbeat tag
+(``toolkit.execution.heartbeat``) that a resume from another machine checks.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Any, Optional
 
 from toolkit.errors import JtError
 from toolkit.execution import describe
+from toolkit.execution.heartbeat import Heartbeat, check_not_owned
 from toolkit.execution.lock import RunLock
 from toolkit.store.tracking import Store
 
@@ -123,11 +126,14 @@ def open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: An
         run = store.get_run(rid)
         if run.info.status == "FINISHED":
             raise JtError(f"run {rid} already finished; nothing to resume")
+        check_not_owned(store, run)  # another machine's live driver (server stores)
         lock = RunLock(store.workdir(rid), rid).acquire(str(store.root))
         try:
             run = store.get_run(rid)  # the owner that just let go may have finished it
             if run.info.status == "FINISHED":
                 raise JtError(f"run {rid} already finished; nothing to resume")
+            check_not_owned(store, run)
+            lock.attach(Heartbeat(store, rid).start())
             _remove_temp_files(store.workdir(rid))
             complete_opening(store, rid, cfg, run)
             store.client.update_run(rid, status="RUNNING")
@@ -158,6 +164,7 @@ def open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: An
     lock = None
     try:  # from here the row exists: every failure must say how to resume it
         lock = RunLock(store.workdir(run_id), run_id).acquire(str(store.root))  # a faster resume: refused here
+        lock.attach(Heartbeat(store, run_id).start())
         os.replace(_staged_path(store, token), store.workdir(run_id) / CONFIG_NAME)
         complete_opening(store, run_id, cfg)
     except BaseException as e:

@@ -60,6 +60,7 @@ class RunLock:
         self.path = Path(workdir) / LOCK_NAME
         self.run_id = run_id
         self._fd: Optional[int] = None
+        self._attached: list = []
 
     @property
     def held(self) -> bool:
@@ -104,8 +105,15 @@ class RunLock:
         self._fd = fd
         return self
 
+    def attach(self, other: object) -> None:
+        """Stop ``other`` (anything with ``stop()``, e.g. a ``heartbeat.Heartbeat``) when the lock is released."""
+        self._attached.append(other)
+
     def release(self) -> None:
-        """Drop the lock (closing the file drops it; the file stays, so no two lockers race on it)."""
+        """Drop the lock (closing the file drops it; the file stays, so no two lockers race on it),
+        after stopping what was attached to it."""
+        while self._attached:
+            self._attached.pop().stop()
         if self._fd is not None:
             fd, self._fd = self._fd, None
             os.close(fd)

@@ -19,6 +19,7 @@ from tests.plugins.jt_executors.ray_cluster import DRIVER_ENV, LocalRayCluster, 
 from tests.toolkit.store.mlflow_server import MlflowServer
 from toolkit.config import compose
 from toolkit.errors import JtError
+from toolkit.execution.heartbeat import HEARTBEAT_TAG, OWNER_TAG, STALE_S, Heartbeat, check_not_owned
 from toolkit.execution.runner import run
 from toolkit.store import h5
 from toolkit.store.server import cache_root
@@ -174,9 +175,43 @@ def test_interrupted_run_resumes_through_the_server(server, example_plugin_dir, 
             proc.communicate()
     run_id = err.split("jt: run ", 1)[1].split()[0]
     assert f"jt run resume={run_id} store={server.uri}" in err
+    store = Store(server.uri)
+    tags = store.get_run(run_id).data.tags
+    assert tags[HEARTBEAT_TAG] == "stopped" and f"pid {proc.pid} on " in tags[OWNER_TAG]
+    # another machine's driver that beat a moment ago owns it: refused in one line, nothing changed
+    store.set_tags(run_id, {OWNER_TAG: "pid 4242 on elsewhere (since 2026-12-02T03:00:00)",
+                            HEARTBEAT_TAG: f"{time.time():.0f}"})
+    refused = run_jt("run", f"resume={run_id}", f"store={server.uri}", extra_path=example_plugin_dir, cwd=tmp_path)
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
+    assert f"run {run_id} is being run by pid 4242 on elsewhere" in refused.stderr
+    assert "jt.resumed" not in store.get_run(run_id).data.tags
+    store.set_tags(run_id, {HEARTBEAT_TAG: f"{time.time() - STALE_S - 5:.0f}"})  # that driver died: stale
     again = run_jt("run", f"resume={run_id}", f"store={server.uri}", extra_path=example_plugin_dir, cwd=tmp_path)
     assert again.returncode == 0, again.stderr
     assert "resumed after" in again.stderr and f"run {run_id} FINISHED" in again.stdout
-    store = Store(server.uri)
     hist = h5.read(store.artifact_dir(run_id) / "search_history.h5")  # downloaded from the server
     assert list(hist["index"]) == list(range(5))
+
+
+def test_the_heartbeat_beats_and_stops(server, tmp_path, monkeypatch):
+    """The owner's tags on a real server: set at start, renewed every period, ``stopped`` at the
+    end; ``check_not_owned`` refuses only another host's fresh beat."""
+    monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
+    store = Store(server.uri)
+    rid = store.start_run("heartbeat", run_name="hb")
+    hb = Heartbeat(store, rid, period_s=0.4).start()
+    try:
+        first = float(store.get_run(rid).data.tags[HEARTBEAT_TAG])
+        time.sleep(1.8)
+        assert float(store.get_run(rid).data.tags[HEARTBEAT_TAG]) >= first + 1
+        check_not_owned(store, store.get_run(rid))  # this host's own: the lock decides
+    finally:
+        hb.stop()
+    assert store.get_run(rid).data.tags[HEARTBEAT_TAG] == "stopped"
+    store.set_tags(rid, {OWNER_TAG: "pid 7 on elsewhere (since now)", HEARTBEAT_TAG: f"{time.time():.0f}"})
+    with pytest.raises(JtError, match="is being run by pid 7 on elsewhere"):
+        check_not_owned(store, store.get_run(rid))
+    check_not_owned(store, store.get_run(rid), now=time.time() + STALE_S + 1)  # stale: a dead owner
+    store.set_tags(rid, {HEARTBEAT_TAG: "stopped"})
+    check_not_owned(store, store.get_run(rid))
+    check_not_owned(Store(tmp_path / "local"), store.get_run(rid))  # a local store: the lock alone
