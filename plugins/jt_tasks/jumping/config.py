@@ -91,6 +91,8 @@ class JumpConfig(PolicyConfig):
                     "must be a finite number > 0")
         require(self.max_time_to_bar is None or (finite(self.max_time_to_bar) and self.max_time_to_bar > 0),
                 "task.max_time_to_bar", self.max_time_to_bar, "must be a number of seconds > 0 (or null: no constraint)")
+        require(self.max_time_to_bar is None or self.name == "highjump", "task.max_time_to_bar", self.max_time_to_bar,
+                f"is for task=highjump (task={self.name} runs straight at its obstacle): leave it null")
         for key in ("obstacle_height", "mat_height", "safe_margin"):
             require(finite(getattr(self, key)) and getattr(self, key) >= 0, f"task.{key}", getattr(self, key),
                     "must be a finite number >= 0")

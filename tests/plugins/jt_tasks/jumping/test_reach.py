@@ -94,3 +94,7 @@ def test_bad_values_are_one_line():
 
     with pytest.raises(JtError, match="task.max_time_to_bar=0.0: must be a number of seconds > 0"):
         _task("task.max_time_to_bar=0")
+    from toolkit.config import compose
+
+    with pytest.raises(JtError, match="task.max_time_to_bar=0.5: is for task=highjump"):
+        compose(["task=obstacle", "search=bds", "experiment=smoke", "task.max_time_to_bar=0.5"])
