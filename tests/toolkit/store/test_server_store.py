@@ -158,8 +158,10 @@ def test_interrupted_run_resumes_through_the_server(server, example_plugin_dir, 
     monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
     args = ["task=quadratic", "task.sleep=2.0", "search=random", "search.budget=5", "executor.workers=1",
             f"store={server.uri}", "seed=1"]
+    # Ctrl-C as in a terminal, also where the suite runs as a background job (SIGINT ignored there)
     proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", *args], env=jt_env(example_plugin_dir),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         err, deadline = "", time.monotonic() + 120
         while "[2/5]" not in err and time.monotonic() < deadline:  # two evaluations done

@@ -170,8 +170,11 @@ def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
     root = tmp_path / "s"
     root.mkdir()
     sqlite3.connect(root / "mlflow.db").execute("create table t (x)").connection.close()  # a store: no MLflow
+    # Ctrl-C as in a terminal: SIGINT handled by default even where the suite itself was started as
+    # a background job (which makes every process it starts ignore SIGINT)
     proc = subprocess.Popen([sys.executable, "-c", FAKE_UI, str(root), str(free_port())], env=jt_env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 60
         while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
