@@ -79,7 +79,16 @@ def check_budget(cfg: Any) -> None:
 
 
 def feasible_mask(problem: SearchProblem, box: UnitBox, u: np.ndarray) -> np.ndarray:
-    """Whether unit points ``u`` ``(n, dim)`` satisfy ``problem.constraint`` ``(n,)`` (all True without one)."""
+    """Whether unit points satisfy ``problem.constraint`` (all True without one).
+
+    Args:
+        problem: the search problem.
+        box: the unit-cube map of its space.
+        u: unit points ``(n, dim)``.
+
+    Returns:
+        ``(n,)`` bools.
+    """
     u = np.atleast_2d(np.asarray(u, dtype=float)).reshape(-1, box.dim)
     if problem.constraint is None:
         return np.ones(len(u), dtype=bool)
@@ -88,12 +97,25 @@ def feasible_mask(problem: SearchProblem, box: UnitBox, u: np.ndarray) -> np.nda
 
 
 def feasible_samples(problem: SearchProblem, box: UnitBox, n: int, seed: int, method: str = "uniform") -> np.ndarray:
-    """``n`` seeded unit points ``(n, dim)`` within ``problem.constraint``.
+    """``n`` seeded unit points within ``problem.constraint``.
 
     Without a constraint exactly ``unit_samples(n, dim, seed, method)``. With one, the first ``n``
     feasible points of that design continued (rejection sampling: later rounds draw ``64 n`` more
     points from seeds derived from ``seed``), so the points are a deterministic function of the
-    arguments; a constraint that leaves no feasible point in ``20 x 64 n`` draws is one ``JtError``.
+    arguments.
+
+    Args:
+        problem: the search problem.
+        box: the unit-cube map of its space.
+        n: number of points.
+        seed: seed of the design.
+        method: ``"uniform"`` or ``"sobol"`` (``random_search.unit_samples``).
+
+    Returns:
+        Unit points ``(n, dim)``.
+
+    Raises:
+        JtError: fewer than ``n`` feasible points in ``n + 20 x 64 n`` draws.
     """
     from jt_searchers.random_search import unit_samples
 

@@ -157,9 +157,10 @@ class BDSSearcher(BudgetedSearcher):
     # ---- picks ----------------------------------------------------------------------------------
 
     def _feasibility(self) -> Any:
-        """The weight of both acquisitions: ``p(feature | x)`` from the told outcomes
-        (``failures="avoid"`` and a failure told) times the known constraint's indicator; None
-        when neither applies (Alg. 1 unchanged)."""
+        """The weight of both acquisitions, or None when neither part applies (Alg. 1 unchanged).
+
+        ``p(feature | x)`` from the told outcomes (``failures="avoid"`` and a failure told) times
+        the known constraint's indicator."""
         learned = None
         if self.cfg.failures == "avoid":
             U, _, ok = self._observed()

@@ -97,7 +97,11 @@ class KnownConstraint:
 
 
 class Product:
-    """Product of weight models (``Feasibility``, ``KnownConstraint``) with the same interface."""
+    """Product of weight models (``Feasibility``, ``KnownConstraint``) with the same interface.
+
+    Args:
+        *models: the models; ``None`` entries are skipped.
+    """
 
     def __init__(self, *models: Any) -> None:
         self.models = [m for m in models if m is not None]

@@ -7,9 +7,11 @@ the run: ``jt.owner`` (``pid N on HOST (since TIME)``, set once) and ``jt.heartb
 renewed every ``PERIOD_S`` seconds by a daemon thread; ``stopped`` when the driver lets go.
 
 A ``resume=`` from another host refuses a run whose heartbeat is younger than ``STALE_S``: its
-owner is alive (or died within the last minute and a half: wait, then resume). On the owner's own
-host the lock decides, which also sees a ``kill -9`` at once. A local store needs no heartbeat:
-one machine, the lock is enough.
+owner is alive (or died within the last minute and a half: wait, then resume). Two resumes from
+two hosts at once both write ``jt.owner``; each reads it back after ``CONFIRM_S`` and only the one
+that finds its own name goes on (``Heartbeat.confirm``). On the owner's own host the lock decides,
+which also sees a ``kill -9`` at once. A local store needs no heartbeat: one machine, the lock is
+enough. The ages compare the clocks of two machines: they should agree within a minute (NTP).
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ PERIOD_S = 30.0
 """Seconds between two beats."""
 STALE_S = 90.0
 """A heartbeat older than this is a dead owner's (three beats missed)."""
+CONFIRM_S = 1.0
+"""Seconds a resume waits before reading ``jt.owner`` back (``Heartbeat.confirm``)."""
 
 
 def owner_text() -> str:
@@ -40,6 +44,7 @@ def owner_text() -> str:
 
 
 def _host_of(owner: str) -> str:
+    """The host of a ``jt.owner`` text (``""`` when it names none)."""
     parts = owner.split(" on ", 1)
     return parts[1].split(" (", 1)[0] if len(parts) == 2 else ""
 
@@ -83,6 +88,7 @@ class Heartbeat:
         self.store, self.run_id, self.period_s = store, run_id, float(period_s)
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
+        self.owner = ""
 
     def start(self) -> "Heartbeat":
         """Set ``jt.owner`` and the first beat, then beat in a daemon thread; returns self."""
@@ -90,9 +96,12 @@ class Heartbeat:
             return self
         from mlflow.tracking import MlflowClient
 
+        from mlflow.entities import RunTag
+
         client = MlflowClient(tracking_uri=self.store.uri)  # its own client: no sharing across threads
-        client.set_tag(self.run_id, OWNER_TAG, owner_text())
-        client.set_tag(self.run_id, HEARTBEAT_TAG, f"{time.time():.0f}")
+        self.owner = owner_text()
+        client.log_batch(self.run_id, tags=[RunTag(OWNER_TAG, self.owner),  # one call: never an owner
+                                            RunTag(HEARTBEAT_TAG, f"{time.time():.0f}")])  # without a beat
 
         def beat() -> None:
             while not self._stop.wait(self.period_s):
@@ -105,13 +114,35 @@ class Heartbeat:
         self._thread.start()
         return self
 
+    def confirm(self, wait_s: float = CONFIRM_S) -> None:
+        """After ``wait_s``, check that ``jt.owner`` still names this process (a resume from
+        another host at the same moment may have written it last); a server store only.
+
+        Raises:
+            JtError: another process took the run (this one stops beating first).
+        """
+        if self._thread is None:
+            return
+        time.sleep(wait_s)
+        run = self.store.get_run(self.run_id)
+        owner = run.data.tags.get(OWNER_TAG, "")
+        if owner != self.owner:
+            self._stop.set()
+            self._thread.join(timeout=5.0)
+            self._thread = None
+            raise JtError(f"run {self.run_id} was taken a moment ago by {owner or 'another process'}; "
+                          "this resume stops (one driver per run)")
+
     def stop(self) -> None:
-        """Stop beating and mark the run ``stopped`` (best effort: a dead server just goes stale)."""
+        """Stop beating and mark the run ``stopped`` (best effort: a dead server just goes stale;
+        a beat still being retried after 5 s leaves the mark out rather than be overwritten)."""
         if self._thread is None:
             return
         self._stop.set()
         self._thread.join(timeout=5.0)
-        self._thread = None
+        alive, self._thread = self._thread.is_alive(), None
+        if alive:
+            return
         try:
             self.store.client.set_tag(self.run_id, HEARTBEAT_TAG, "stopped")
         except Exception:  # noqa: BLE001

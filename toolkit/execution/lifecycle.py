@@ -133,7 +133,9 @@ def open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: An
             if run.info.status == "FINISHED":
                 raise JtError(f"run {rid} already finished; nothing to resume")
             check_not_owned(store, run)
-            lock.attach(Heartbeat(store, rid).start())
+            beat = Heartbeat(store, rid).start()
+            lock.attach(beat)
+            beat.confirm()  # two hosts resuming at once: the last to write jt.owner goes on
             _remove_temp_files(store.workdir(rid))
             complete_opening(store, rid, cfg, run)
             store.client.update_run(rid, status="RUNNING")

@@ -84,8 +84,9 @@ class SearchProblem:
         distinct_threshold: two features closer than this count as the same strategy.
         constraint: a known constraint on the box, ``X (n, dim) -> margins (n,)``: a point is
             feasible where its margin is >= 0 (e.g. the high jump's take-off states whose run-up
-            reaches the bar plane in flight). Searchers with ``honours_constraint`` propose only
-            feasible points; the others refuse a constrained problem. ``None``: the whole box.
+            reaches the bar plane in flight). Searchers with ``honours_constraint`` keep to it
+            (``search=single`` by evaluating only the one point it is given); the others refuse a
+            constrained problem. ``None``: the whole box.
         constraint_name: what the constraint is, for messages (e.g. ``task.max_time_to_bar=0.5``).
     """
 
@@ -119,8 +120,9 @@ class Searcher(Plugin, abc.ABC):
         nested: True (default): each evaluation is a nested MLflow run under the outer run;
             False: the one evaluation is logged on the outer run itself (``search=single``).
         honours_constraint: True when the searcher proposes only points within
-            ``SearchProblem.constraint``; a searcher that does not (the default) refuses a
-            constrained problem in one line rather than silently sampling outside it.
+            ``SearchProblem.constraint`` (``search=single``: it proposes nothing, it evaluates
+            the point it is given); a searcher that does not (the default) refuses a constrained
+            problem in one line rather than silently sampling outside it.
 
     Args:
         problem: what to search.

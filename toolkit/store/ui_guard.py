@@ -26,7 +26,8 @@ STOP_S = 15.0
 
 
 def _stop_group(child: subprocess.Popen) -> None:
-    """SIGTERM the group (the guard ignores it), wait for the server, then SIGKILL what is left."""
+    """SIGTERM the group (the guard ignores it), wait up to ``STOP_S`` for the server, then
+    SIGKILL whatever is left of the group (a worker that outlived it), the guard with it."""
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     try:
         os.killpg(0, signal.SIGTERM)
@@ -35,11 +36,20 @@ def _stop_group(child: subprocess.Popen) -> None:
     try:
         child.wait(timeout=STOP_S)
     except subprocess.TimeoutExpired:
-        os.killpg(0, signal.SIGKILL)  # the server and its workers, and the guard with them
+        pass
+    os.killpg(0, signal.SIGKILL)  # the last act: nothing of the group keeps the port
 
 
 def main(argv: list[str]) -> int:
-    """``JT_PID CMD...``: run ``CMD`` until it exits, jt goes or a SIGTERM comes; the exit status."""
+    """Run ``CMD`` until it exits, jt goes or a SIGTERM comes (run as its own process only: it
+    signals its whole process group when it stops).
+
+    Args:
+        argv: ``[JT_PID, CMD...]``.
+
+    Returns:
+        The server's exit status; 2 for a bad command line. A stop ends in SIGKILL of the group.
+    """
     if len(argv) < 2 or not argv[0].isdigit():
         print("usage: python -m toolkit.store.ui_guard JT_PID CMD...", file=sys.stderr)
         return 2

@@ -45,7 +45,16 @@ class BarReach:
 
     @classmethod
     def of_task(cls, task: Any, names: list[str], t_max: float) -> "BarReach":
-        """The constraint of a high-jump task whose searched features are ``names``."""
+        """The constraint of a high-jump task.
+
+        Args:
+            task: the ``HighJumpTask`` (its params, fixed features and take-off file).
+            names: its searched features, in the order of a point's columns.
+            t_max: ``task.max_time_to_bar`` (s).
+
+        Returns:
+            The constraint, with the take-off state's forward speed.
+        """
         from jt_tasks.takeoff.state import facing_velocities, takeoff_state
 
         p = task.params

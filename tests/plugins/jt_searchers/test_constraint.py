@@ -43,8 +43,6 @@ def test_bds_keeps_every_pick_within_the_constraint(cfg) -> None:
 
     X = _run(BDSSearcher, cfg)
     assert len(X) == 12 and np.all(_margin(X) >= 0.0), X[_margin(X) < 0]
-    # exploration (argmax sigma) would go to the corners; the feasible ones are (1, 0), (0, 1), (1, 1)
-    assert np.all(np.linalg.norm(X, axis=1) > 0.5)
     np.testing.assert_array_equal(X, _run(BDSSearcher, cfg))  # same seed, same picks
 
 

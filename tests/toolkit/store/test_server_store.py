@@ -217,3 +217,21 @@ def test_the_heartbeat_beats_and_stops(server, tmp_path, monkeypatch):
     store.set_tags(rid, {HEARTBEAT_TAG: "stopped"})
     check_not_owned(store, store.get_run(rid))
     check_not_owned(Store(tmp_path / "local"), store.get_run(rid))  # a local store: the lock alone
+
+
+def test_of_two_resumes_at_once_only_the_last_to_write_goes_on(server, tmp_path, monkeypatch):
+    """Both write ``jt.owner``; read back after the confirm delay, only the one named there stays."""
+    monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
+    store = Store(server.uri)
+    rid = store.start_run("heartbeat", run_name="race")
+    first = Heartbeat(store, rid, period_s=60).start()
+    second = Heartbeat(store, rid, period_s=60).start()
+    second.owner = first.owner + " [second]"  # two processes of this test: tell them apart
+    store.set_tags(rid, {OWNER_TAG: second.owner})
+    try:
+        with pytest.raises(JtError, match=f"run {rid} was taken a moment ago by .*\\[second\\]"):
+            first.confirm(wait_s=0.1)
+        second.confirm(wait_s=0.1)
+    finally:
+        first.stop()
+        second.stop()

@@ -228,10 +228,15 @@ def test_kill_9_of_jt_ui_stops_the_server_tree(tmp_path):
 
 
 def test_the_guard_passes_the_servers_exit_status_on():
-    from toolkit.store.ui_guard import main
-
-    assert main([str(os.getpid()), sys.executable, "-c", "raise SystemExit(3)"]) == 3
-    assert main(["nope", "x"]) == 2
+    """Run as jt runs it (a process of its own whose parent is the given pid), never in pytest's
+    process: the guard signals its whole process group when it stops."""
+    guard = [sys.executable, "-m", "toolkit.store.ui_guard"]
+    done = subprocess.run([*guard, str(os.getpid()), sys.executable, "-c", "raise SystemExit(3)"], env=jt_env(),
+                          start_new_session=True, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 3, done.stderr
+    bad = subprocess.run([*guard, "nope", "x"], env=jt_env(), start_new_session=True, capture_output=True,
+                         text=True, timeout=60)
+    assert bad.returncode == 2 and "usage:" in bad.stderr
 
 
 def _state(pid):

@@ -39,8 +39,8 @@ def test_speed_and_distance_are_the_scenes(point):
 
 
 def test_the_laptop_runs_states_fall_on_the_side_they_were_measured():
-    """Laptop runs (docs/highjump.md): the states reaching the plane within 0.45 s crossed, those at
-    0.75 s and 2.5 s mostly did not; the laptop preset's 0.55 s keeps the first, drops the second
+    """Two laptop runs (docs/highjump.md): the states that crossed reach the plane within 0.45 s,
+    the ones at 0.75 s and 2.5 s mostly did not cross; the laptop preset's 0.55 s keeps the first, drops the second
     and keeps every take-off state of 000 Table 3."""
     from toolkit import plugins
     from toolkit.config import compose
@@ -61,7 +61,7 @@ def test_the_laptop_runs_states_fall_on_the_side_they_were_measured():
 
 def test_a_state_running_along_the_bar_never_crosses_it():
     """Why such states are dropped: holding the take-off pose, a state with v_n = 0.36 m/s (2.5 s
-    to the plane) comes down before the bar plane, one with 0.42 s crosses it (real PyBullet)."""
+    to the plane) comes down before the bar plane, the Fosbury state (0.40 s) crosses it (real PyBullet)."""
     from jt_tasks.jumping.env import JumpEnv
 
     task = _task()
