@@ -162,32 +162,48 @@ main()
 """
 
 
-def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
-    """SIGINT to ``jt ui`` (Ctrl-C in its terminal; the server has a session of its own, so only jt
-    gets it) ends the server's whole process group. MLflow is replaced by a two-process tree."""
+def _fake_ui(tmp_path):
+    """``jt ui`` on a store with MLflow replaced by a two-process tree; ``(jt's process, the
+    tree's pids)`` once both are up. SIGINT is handled by default in jt, as in a terminal, also
+    where the suite itself runs as a background job (which makes every process it starts ignore it)."""
     import sqlite3
 
     root = tmp_path / "s"
     root.mkdir()
     sqlite3.connect(root / "mlflow.db").execute("create table t (x)").connection.close()  # a store: no MLflow
-    # Ctrl-C as in a terminal: SIGINT handled by default even where the suite itself was started as
-    # a background job (which makes every process it starts ignore SIGINT)
     proc = subprocess.Popen([sys.executable, "-c", FAKE_UI, str(root), str(free_port())], env=jt_env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 60
+    while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
+        if time.monotonic() > deadline or proc.poll() is not None:
+            proc.kill()
+            raise AssertionError(proc.communicate(timeout=10))
+        time.sleep(0.1)
+    return proc, [int(p) for p in (root / "pids").read_text().split()]
+
+
+def _alive(pids):
+    """The pids still running (zombies count as gone)."""
+    return [p for p in pids if os.path.exists(f"/proc/{p}") and "Z" not in _state(p)]
+
+
+def _wait_gone(pids, seconds):
+    deadline = time.monotonic() + seconds
+    while _alive(pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return _alive(pids)
+
+
+def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
+    """SIGINT to ``jt ui`` (Ctrl-C in its terminal; the server has a session of its own, so only jt
+    gets it) ends the server's whole process group. MLflow is replaced by a two-process tree."""
+    proc, pids = _fake_ui(tmp_path)
     try:
-        deadline = time.monotonic() + 60
-        while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
-            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate(timeout=10)
-            time.sleep(0.1)
-        pids = [int(p) for p in (root / "pids").read_text().split()]
-        assert all(os.path.exists(f"/proc/{p}") for p in pids)
+        assert _alive(pids) == pids
         proc.send_signal(signal.SIGINT)
         assert proc.wait(timeout=30) == 0
-        deadline = time.monotonic() + 10
-        while any(os.path.exists(f"/proc/{p}") and "Z" not in _state(p) for p in pids) and time.monotonic() < deadline:
-            time.sleep(0.1)
-        assert not [p for p in pids if os.path.exists(f"/proc/{p}") and "Z" not in _state(p)], "outlived jt ui"
+        assert not _wait_gone(pids, 10), "outlived jt ui"
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -197,30 +213,15 @@ def test_ctrl_c_stops_the_server_and_its_worker(tmp_path):
 def test_kill_9_of_jt_ui_stops_the_server_tree(tmp_path):
     """``kill -9`` of ``jt ui`` runs no handler of jt's: the guard in the server's group notices
     that jt is gone and ends the server and its worker (issue 15: the server used to keep the port)."""
-    import sqlite3
-
     from toolkit.store import ui_guard
 
-    root = tmp_path / "s"
-    root.mkdir()
-    sqlite3.connect(root / "mlflow.db").execute("create table t (x)").connection.close()
-    proc = subprocess.Popen([sys.executable, "-c", FAKE_UI, str(root), str(free_port())], env=jt_env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc, pids = _fake_ui(tmp_path)
     try:
-        deadline = time.monotonic() + 60
-        while not (root / "pids").is_file() or len((root / "pids").read_text().split()) < 2:
-            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate(timeout=10)
-            time.sleep(0.1)
-        pids = [int(p) for p in (root / "pids").read_text().split()]
-        guard = [k for k in _children(proc.pid) if "ui_guard" in k[2]]
+        guard = [int(k[0]) for k in _children(proc.pid) if "ui_guard" in k[2]]
         assert len(guard) == 1, _children(proc.pid)
         proc.kill()
         proc.wait()
-        deadline = time.monotonic() + 5 * ui_guard.PERIOD_S + 10
-        alive = lambda: [p for p in pids + [int(guard[0][0])] if os.path.exists(f"/proc/{p}") and "Z" not in _state(p)]
-        while alive() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        assert not alive(), "the server outlived a kill -9 of jt ui"
+        assert not _wait_gone(pids + guard, 5 * ui_guard.PERIOD_S + 10), "the server outlived a kill -9 of jt ui"
     finally:
         if proc.poll() is None:
             proc.kill()
