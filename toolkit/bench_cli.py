@@ -134,6 +134,7 @@ def bench_rollout(
     steps: int = typer.Option(400, "--steps", help="Timed control steps per rate."),
     collect_steps: int = typer.Option(64, "--collect-steps", help="Collection steps per env (16 envs per worker)."),
     workers: str = typer.Option("1,2", "--workers", help="Worker counts of the collection measurement."),
+    loops: str = typer.Option("auto", "--loops", help="Comma list of substep loops (sim.loop): auto, compiled, python."),
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
 ) -> None:
     """Where a policy env's time goes per 600 Hz substep, and PPO collection samples/s per worker."""
@@ -152,12 +153,18 @@ def bench_rollout(
         raise JtError(f"--rates and --workers take comma lists of numbers, got {rates!r}, {workers!r}") from None
     if not rate_list or any(r <= 0 for r in rate_list) or not worker_list or any(w < 1 for w in worker_list):
         raise JtError("--rates must be positive rates and --workers counts >= 1")
+    loop_list = [x.strip() for x in loops.split(",") if x.strip()]
+    bad = [x for x in loop_list if x not in ("auto", "compiled", "python")]
+    if bad or not loop_list:
+        raise JtError(f"--loops {loops!r}: choose from auto, compiled, python (a comma list)")
     out = {"machine": machine_info(), "results": []}
     for t in names:
-        typer.echo(f"{t}: measuring ...")
-        res = run_bench(t, ["action=raw", f"spd={spd}"], rate_list, steps, collect_steps, worker_list, echo=typer.echo)
-        typer.echo(format_table(res))
-        out["results"].append(res)
+        for loop in loop_list:
+            typer.echo(f"{t}, sim.loop={loop}: measuring ...")
+            res = run_bench(t, ["action=raw", f"spd={spd}", f"sim.loop={loop}"], rate_list, steps,
+                            collect_steps, worker_list, echo=typer.echo)
+            typer.echo(format_table(res))
+            out["results"].append(res)
     if json_out:
         json_out.parent.mkdir(parents=True, exist_ok=True)
         json_out.write_text(json.dumps(out, indent=2))

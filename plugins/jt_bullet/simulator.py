@@ -72,6 +72,7 @@ class BulletSimulator(SceneQueries, Simulator):
         self.dt = 1.0 / p.sim_hz
         spd_node = _get(cfg, "spd")
         spd_name = str(_get(spd_node, "name") or "maba")
+        self.spd_name = spd_name
         self.backend = plugins.load("spd", spd_name)(spd_node)
         self.steps_itself = bool(getattr(self.backend, "steps_itself", False))
         if self.steps_itself and p.root_servo.kp != 0.0:
@@ -116,6 +117,25 @@ class BulletSimulator(SceneQueries, Simulator):
         self.timers = {"spd_s": 0.0, "substep_s": 0.0, "physics_s": 0.0, "io_s": 0.0, "loop_s": 0.0, "substeps": 0}
         self.step_log: list | None = None
         self._last: dict[str, Any] = {}
+        self._compiled: Any = None  # jt_bullet.compiled.CompiledSteps, False: the Python loop
+        if p.loop not in ("auto", "compiled", "python"):
+            self.close()
+            raise JtError(f"sim.loop={p.loop!r}: choose auto, compiled or python")
+        if p.loop != "python":
+            from jt_bullet import compiled
+
+            why = compiled.unavailable(self)
+            if why and p.loop == "compiled":
+                self.close()
+                raise JtError(f"sim.loop=compiled: not available here: {why}; use sim.loop=auto or python")
+            self._compiled = False if why else compiled.CompiledSteps(self)
+        else:
+            self._compiled = False
+
+    @property
+    def loop(self) -> str:
+        """``"compiled"`` or ``"python"``: the substep loop this simulator runs."""
+        return "compiled" if self._compiled else "python"
 
     # ------------------------------------------------------------------ characters
     @classmethod
@@ -205,7 +225,7 @@ class BulletSimulator(SceneQueries, Simulator):
 
     def state(self) -> tuple[np.ndarray, np.ndarray]:
         """Current ``(q (n_q,), qd (n_dof,))`` (copies)."""
-        q, qd = self.io.read()
+        q, qd = self._compiled.read() if self._compiled else self.io.read()
         return q.copy(), qd.copy()
 
     def step(self, q_target: np.ndarray, qd_target: np.ndarray | None = None,
@@ -242,6 +262,8 @@ class BulletSimulator(SceneQueries, Simulator):
         n = self.n_substeps if n_substeps is None else int(n_substeps)
         kp, kd, lim, dt, tau = self.kp, self.kd, self.torque_limit, self.dt, self._tau
         neg_lim = self._neg_limit
+        if self._compiled and self.step_log is None:
+            return self._step_compiled(qt, vt, n, watch)
         solve = getattr(be, "solve", be.torques)  # the backend's lean path when it has one
         check = watcher.Checker(self, watch, n)
         perf = time.perf_counter
@@ -289,14 +311,36 @@ class BulletSimulator(SceneQueries, Simulator):
         tm["io_s"] += io_s
         tm["loop_s"] += perf() - t_start
         tm["substeps"] += done
+        return self._record(q, qd, tau, done, check.result(self.failed, self.reason))
+
+    def _step_compiled(self, qt: np.ndarray, vt: np.ndarray | None, n: int,
+                       watch: Watch | None) -> dict[str, Any]:
+        """``step`` through ``jt_bullet.fastloop`` (the same record)."""
+        from jt_bullet import fastloop as fl
+
+        cs = self._compiled
+        t_start = time.perf_counter()
+        cs.timers[:] = 0.0
+        done, result = cs.step(qt, vt, n, watch)
+        tm, ct = self.timers, cs.timers
+        tm["spd_s"] += float(ct[fl.T_SPD])
+        tm["substep_s"] += float(ct[fl.T_SUB])
+        tm["physics_s"] += float(ct[fl.T_PHYS])
+        tm["io_s"] += float(ct[fl.T_IO])
+        tm["loop_s"] += time.perf_counter() - t_start
+        tm["substeps"] += done
+        return self._record(self.io.q, self.io.qd, self._tau, done, result)
+
+    def _record(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, done: int,
+                result: dict[str, Any]) -> dict[str, Any]:
+        """The step record (``step``'s Returns) of a finished control step."""
         rec = {"time": self.time, "q": q.copy(), "qd": qd.copy(),
                "tau": np.full(self.model.n_v, np.nan) if self.steps_itself else tau.copy()}
         if self.params.contacts:
             touching, n_pts = self._contacts()
         else:
             touching, n_pts = np.zeros(self.n_links + 1, dtype=bool), 0
-        rec.update(contacts=touching, n_contacts=n_pts, failed=self.failed, substeps=done,
-                   **check.result(self.failed, self.reason))
+        rec.update(contacts=touching, n_contacts=n_pts, failed=self.failed, substeps=done, **result)
         self._last = rec
         return rec
 

@@ -47,3 +47,7 @@ class PCGBackend(ToolkitSPD):
             z if tau_ext is None else c(tau_ext, f), m.gravity, d.wb, d.wv, d.sc, d.H, d.A, _PCG,
             self.tol, self.max_iter_factor * m.n_v)
         return d.tau
+
+    def solve(self, q, qd, q_target, kp, kd, dt, qd_target=None):  # noqa: D102
+        """``torques`` with this backend's ``tol`` and iteration cap (the simulator's per-substep path)."""
+        return self.torques(q, qd, q_target, kp, kd, dt, qd_target)

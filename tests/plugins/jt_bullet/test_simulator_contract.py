@@ -11,3 +11,13 @@ class TestBulletSimulator(SimulatorContract):
 
         return load_simulator({"sim": {"name": "bullet", **sim}, "spd": {"name": "df"},
                                "character": {"name": "humanoid"}})
+
+
+class TestBulletSimulatorPythonLoop(SimulatorContract):
+    """The same contract on the reference Python substep loop (``sim.loop=python``)."""
+
+    def make(self, **sim):
+        from jt_tasks.policy.env import load_simulator
+
+        return load_simulator({"sim": {"name": "bullet", "loop": "python", **sim}, "spd": {"name": "df"},
+                               "character": {"name": "humanoid"}})

@@ -1,0 +1,287 @@
+"""A control step's 600 Hz substeps in one numba loop, through PyBullet's C API.
+
+Each substep does what ``BulletSimulator``'s Python loop does, in the same order and on the same
+doubles: SPD torques by the backend's kernel (MABA, DF, SF or PCG from ``toolkit.dynamics``),
+clipped to the torque limits, applied with one torque command, one ``stepSimulation``, the state
+read back, the NaN / explosion check, then at every ``check_every``-th substep the episode's
+``Watch``: the recorded quantities, the contacts of the character and the first contact rule that
+fires (with the closest-point query of a ``clear_of`` rule), the first touches, the time limit.
+The same seed gives the same trajectory, bit for bit, as the Python loop
+(``tests/plugins/jt_bullet/test_fastloop.py``).
+
+The C functions' addresses come in as an array (``funcs()``), called through ``_c_call``
+intrinsics, so the compiled loop can be cached on disk and its dispatch stays cheap.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+from jt_bullet import capi
+from toolkit.dynamics.com import com_kernel
+from toolkit.dynamics.maba import maba_kernel
+from toolkit.dynamics.model import V_TAU
+from toolkit.dynamics.spd import spd_system_kernel
+
+#: failure codes of ``substeps`` (``iout[1]``)
+OK, NAN_STATE, FAST, FAR, BAD_TORQUE = 0, 1, 2, 3, 4
+#: SPD kernels (``method``): MABA, or the explicit system by DF / SF / PCG (spd_system_kernel's modes)
+MABA, DF, SF, PCG = -1, 0, 1, 2
+#: ``iout`` entries: substeps done, failure code, fired rule (-1: none, -2: the time limit), records, PCG iterations
+I_DONE, I_FAIL, I_RULE, I_REC, I_ITS = range(5)
+#: ``timers`` entries (seconds): SPD, physics, state/torque I/O, whole substeps
+T_SPD, T_PHYS, T_IO, T_SUB = range(4)
+capi_point_words = capi.POINT_WORDS
+_BODY_B, _LINK_A = capi.POINT_BODY_B, capi.POINT_LINK_A
+
+
+def _c_call(restype, *argtypes):
+    """A numba intrinsic ``call(address, (args...))`` calling the C function at ``address`` with
+    the signature ``restype(*argtypes)``: addresses arrive at run time (``FUNCS``' array), so the
+    loop that calls them can be cached on disk (ctypes function objects as arguments cost ~20 µs
+    of dispatch per call; as globals they would be frozen into the cache)."""
+
+    @intrinsic
+    def call(typingctx, address, args):
+        def codegen(context, builder, signature, llargs):
+            ptr, tup = llargs
+            ret = ir.VoidType() if restype is types.void else context.get_value_type(restype)
+            fnty = ir.FunctionType(ret, [context.get_value_type(t) for t in argtypes])
+            fn = builder.inttoptr(ptr, fnty.as_pointer())
+            vals = [context.cast(builder, builder.extract_value(tup, i), signature.args[1][i], t)
+                    for i, t in enumerate(argtypes)]
+            out = builder.call(fn, vals)
+            return context.get_dummy_value() if restype is types.void else out
+
+        return (types.none if restype is types.void else restype)(address, args), codegen
+
+    return call
+
+
+_i64, _i32, _f64, _void = types.int64, types.int32, types.float64, types.void
+#: the C functions the loop calls, in ``FUNCS`` order: (name, numba intrinsic)
+_C = (
+    ("b3SubmitClientCommandAndWaitStatus", _c_call(_i64, _i64, _i64)),
+    ("b3GetStatusType", _c_call(_i32, _i64)),
+    ("b3InitStepSimulationCommand", _c_call(_i64, _i64)),
+    ("b3RequestActualStateCommandInit", _c_call(_i64, _i64, _i32)),
+    ("b3GetStatusActualState", _c_call(_i32, *[_i64] * 8)),
+    ("b3JointControlCommandInit2", _c_call(_i64, _i64, _i32, _i32)),
+    ("b3JointControlSetDesiredForceTorqueMultiDof", _c_call(_i32, _i64, _i32, _i64, _i32)),
+    ("b3InitRequestContactPointInformation", _c_call(_i64, _i64)),
+    ("b3SetContactFilterBodyA", _c_call(_void, _i64, _i32)),
+    ("b3GetContactPointInformation", _c_call(_void, _i64, _i64)),
+    ("b3InitClosestDistanceQuery", _c_call(_i64, _i64)),
+    ("b3SetClosestDistanceFilterBodyA", _c_call(_void, _i64, _i32)),
+    ("b3SetClosestDistanceFilterBodyB", _c_call(_void, _i64, _i32)),
+    ("b3SetClosestDistanceThreshold", _c_call(_void, _i64, _f64)),
+    ("memcpy", _c_call(_i64, _i64, _i64, _i64)),
+    ("clock_gettime", _c_call(_i32, _i32, _i64)),
+)
+(_submit, _status_type, _step_init, _state_init, _actual_state, _control_init, _set_forces,
+ _contact_init, _contact_filter_a, _contact_info, _closest_init, _closest_a, _closest_b,
+ _closest_threshold, _memcpy, _clock) = (c for _n, c in _C)
+(SUBMIT, STATUS_TYPE, STEP_INIT, STATE_INIT, ACTUAL_STATE, CONTROL_INIT, SET_FORCES, CONTACT_INIT,
+ CONTACT_FILTER_A, CONTACT_INFO, CLOSEST_INIT, CLOSEST_A, CLOSEST_B, CLOSEST_THRESHOLD, MEMCPY,
+ CLOCK) = range(len(_C))
+
+
+def funcs() -> np.ndarray:
+    """The addresses ``(16,)`` int64 of ``_C``'s functions in this process (PyBullet's C API, libc)."""
+    _lib, f, _arr = capi.library()
+    libc = ctypes.CDLL(None)
+    out = []
+    for name, _call in _C:
+        fn = f[name] if name in f else getattr(libc, name)
+        out.append(ctypes.cast(fn, ctypes.c_void_p).value)
+    return np.array(out, dtype=np.int64)
+
+
+@njit(cache=True)
+def _now(fns, ts) -> float:
+    _clock(fns[CLOCK], (1, ts.ctypes.data))  # CLOCK_MONOTONIC
+    return ts[0] + 1e-9 * ts[1]
+
+
+@njit(cache=True)
+def read_state(fns, h, body, holder, bq, bu, qmap, umap, q, qd) -> None:
+    """Request the body's state and gather it into ``q`` ``(n_q,)``, ``qd`` ``(n_v,)`` (jt layout)."""
+    status = _submit(fns[SUBMIT], (h, _state_init(fns[STATE_INIT], (h, body))))
+    hp = holder.ctypes.data
+    _actual_state(fns[ACTUAL_STATE], (status, 0, 0, 0, 0, hp, hp + 8, 0))
+    _memcpy(fns[MEMCPY], (bq.ctypes.data, holder[0], bq.size * 8))
+    _memcpy(fns[MEMCPY], (bu.ctypes.data, holder[1], bu.size * 8))
+    for i in range(q.shape[0]):
+        q[i] = bq[qmap[i]]
+    for i in range(qd.shape[0]):
+        qd[i] = bu[umap[i]]
+
+
+@njit(cache=True)
+def _contacts(fns, h, body, cinfo, cinfo32, pts, ok_status) -> int:
+    """Contact points of ``body`` now into ``pts`` (int32 words of b3ContactPointData); their count."""
+    cmd = _contact_init(fns[CONTACT_INIT], (h,))
+    _contact_filter_a(fns[CONTACT_FILTER_A], (cmd, body))
+    status = _submit(fns[SUBMIT], (h, cmd))
+    if _status_type(fns[STATUS_TYPE], (status,)) != ok_status:
+        return 0
+    _contact_info(fns[CONTACT_INFO], (h, cinfo.ctypes.data))
+    n = cinfo32[0]
+    cap = pts.shape[0] // capi_point_words
+    if n > cap:
+        n = cap
+    _memcpy(fns[MEMCPY], (pts.ctypes.data, cinfo[1], n * capi_point_words * 4))
+    return n
+
+
+@njit(cache=True)
+def _near(fns, h, body, other, margin, cinfo, cinfo32, ok_status) -> bool:
+    """Any part of ``body`` within ``margin`` m of ``other`` (PyBullet's getClosestPoints)."""
+    if other < 0:
+        return False
+    cmd = _closest_init(fns[CLOSEST_INIT], (h,))
+    _closest_a(fns[CLOSEST_A], (cmd, body))
+    _closest_b(fns[CLOSEST_B], (cmd, other))
+    _closest_threshold(fns[CLOSEST_THRESHOLD], (cmd, margin))
+    status = _submit(fns[SUBMIT], (h, cmd))
+    if _status_type(fns[STATUS_TYPE], (status,)) != ok_status:
+        return False
+    _contact_info(fns[CONTACT_INFO], (h, cinfo.ctypes.data))
+    return cinfo32[0] > 0
+
+
+@njit(cache=True)
+def substeps(fns, h, body, n, every, active, qt, qdt, kp, kd, lim, dt, t,
+             mi, mf, lam, grav, wb, wv, sc, H, A, zeros, method, tol, max_iter,
+             qmap, umap, j_uindex, j_start, j_count, q, qd, bq, bu, holder, ts,
+             cinfo, cinfo32, pts, ok_state, ok_contact,
+             explode_speed, explode_d2, fixed_base,
+             rule_body, rule_mask, rule_fail, rule_clear, rule_margin,
+             touch_body, touched, touched_any, rec_time, rec_com, rec_root, rec_flags,
+             c_mass, c_com, c_world, c_wb, c_sc, time_limit, timers, iout, fout) -> None:
+    """Run up to ``n`` substeps (see the module docstring); results in ``q``, ``qd``, ``wv[V_TAU]``
+    (the last clipped torques), ``iout``, ``fout`` (``[time, max |qd|]``), ``touched`` and the
+    ``rec_*`` rows, timings added to ``timers``."""
+    tau = wv[V_TAU]
+    nv = qd.shape[0]
+    nr = rule_body.shape[0]
+    nt = touch_body.shape[0]
+    read_state(fns, h, body, holder, bq, bu, qmap, umap, q, qd)
+    done = 0
+    fail = OK
+    fired = -1
+    n_rec = 0
+    its = 0
+    vmax = 0.0
+    for k in range(n):
+        t0 = _now(fns, ts)
+        if method == MABA:
+            maba_kernel(mi, mf, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv, sc)
+        else:
+            its = spd_system_kernel(mi, mf, lam, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv,
+                                    sc, H, A, method, tol, max_iter)
+        t1 = _now(fns, ts)
+        s = 0.0
+        for i in range(nv):
+            x = tau[i]
+            if x > lim[i]:  # np.minimum / np.maximum keep a NaN, as these comparisons do
+                x = lim[i]
+            if x < -lim[i]:
+                x = -lim[i]
+            tau[i] = x
+            s += x
+        if not np.isfinite(s):
+            fail = BAD_TORQUE
+            break
+        cmd = _control_init(fns[CONTROL_INIT], (h, body, 1))  # CONTROL_MODE_TORQUE
+        for j in range(j_uindex.shape[0]):
+            _set_forces(fns[SET_FORCES], (cmd, j_uindex[j], tau.ctypes.data + 8 * j_start[j], j_count[j]))
+        _submit(fns[SUBMIT], (h, cmd))
+        t2 = _now(fns, ts)
+        _submit(fns[SUBMIT], (h, _step_init(fns[STEP_INIT], (h,))))
+        t3 = _now(fns, ts)
+        read_state(fns, h, body, holder, bq, bu, qmap, umap, q, qd)
+        t4 = _now(fns, ts)
+        timers[T_SPD] += t1 - t0
+        timers[T_PHYS] += t3 - t2
+        timers[T_IO] += (t2 - t1) + (t4 - t3)
+        timers[T_SUB] += t4 - t0
+        done += 1
+        t += dt
+        # the NaN / explosion check (BulletSimulator._check on BulletBody.read's floats)
+        sq = 0.0
+        for i in range(q.shape[0]):
+            sq += q[i]
+        sv = 0.0
+        vmax = 0.0
+        for i in range(nv):
+            sv += qd[i]
+            a = abs(qd[i])
+            if a > vmax:
+                vmax = a
+        if not (np.isfinite(sq + sv) and vmax <= explode_speed and (
+                fixed_base or q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= explode_d2)):
+            finite = True
+            for i in range(q.shape[0]):
+                if not np.isfinite(q[i]):
+                    finite = False
+            for i in range(nv):
+                if not np.isfinite(qd[i]):
+                    finite = False
+            fail = NAN_STATE if not finite else (FAST if vmax > explode_speed else FAR)
+            break
+        if not active or ((k + 1) % every != 0 and k + 1 < n):
+            continue
+        # the Watch (jt_bullet.watch.Checker.after_substep)
+        if rec_flags[0]:
+            rec_time[n_rec] = t
+        if rec_flags[1]:
+            com_kernel(mi, mf, q, c_wb, c_sc, c_mass, c_com, c_world, rec_com[n_rec])
+        if rec_flags[2]:
+            for i in range(7):
+                rec_root[n_rec, i] = q[i]
+        if rec_flags[0] or rec_flags[1] or rec_flags[2]:
+            n_rec += 1
+        npts = 0
+        if nr > 0 or nt > 0:
+            npts = _contacts(fns, h, body, cinfo, cinfo32, pts, ok_contact)
+        hit_rule = -1
+        for r in range(nr):
+            hit = False
+            for p in range(npts):
+                if pts[p * capi_point_words + _BODY_B] == rule_body[r] and \
+                        rule_mask[r, pts[p * capi_point_words + _LINK_A] + 1]:
+                    hit = True
+                    break
+            if hit and (rule_fail[r] or rule_clear[r] < 0
+                        or not _near(fns, h, body, rule_clear[r], rule_margin[r], cinfo, cinfo32,
+                                     ok_contact)):
+                hit_rule = r
+                break
+        if hit_rule >= 0 and rule_fail[hit_rule]:
+            fired = hit_rule
+            break
+        for b in range(nt):
+            if not touched_any[b]:
+                for p in range(npts):
+                    if pts[p * capi_point_words + _BODY_B] == touch_body[b]:
+                        touched[b, pts[p * capi_point_words + _LINK_A] + 1] = True
+                        touched_any[b] = True
+        if hit_rule >= 0:
+            fired = hit_rule
+            break
+        if t >= time_limit - 1e-9:
+            fired = -2
+            break
+    iout[I_DONE] = done
+    iout[I_FAIL] = fail
+    iout[I_RULE] = fired
+    iout[I_REC] = n_rec
+    iout[I_ITS] = its
+    fout[0] = t
+    fout[1] = vmax
