@@ -156,12 +156,33 @@ class Skeleton:
         return np.concatenate(parts, axis=-1)
 
     def dofs_to_joints(self, dofs: np.ndarray) -> np.ndarray:
-        """Dof layout ``(..., n_dof)`` → quaternion layout ``(..., n_q)``."""
+        """Dof layout ``(..., n_dof)`` → quaternion layout ``(..., n_q)``: every spherical joint's
+        exp map through one ``quat_from_expmap`` call (the per-step hot path of every action space)."""
         dofs = np.asarray(dofs, dtype=np.float64)
-        parts = []
-        for j, s in zip(self.joints, self.dof_slices.values()):
-            parts.append(rot.quat_from_expmap(dofs[..., s]) if j.kind == SPHERICAL else dofs[..., s])
-        return np.concatenate(parts, axis=-1)
+        sph_dof, sph_q, rev_dof, rev_q = self._conversion_columns()
+        out = np.empty(dofs.shape[:-1] + (self.n_q,))
+        out[..., rev_q] = dofs[..., rev_dof]
+        if len(sph_dof):
+            out[..., sph_q] = rot.quat_from_expmap(dofs[..., sph_dof])
+        return out
+
+    def _conversion_columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Dof columns ``(n_spherical, 3)`` and quaternion columns ``(n_spherical, 4)`` of the
+        spherical joints, dof and quaternion columns ``(n_revolute,)`` of the others (cached)."""
+        cached = self.__dict__.get("_columns")
+        if cached is None:
+            sph_dof, sph_q, rev_dof, rev_q = [], [], [], []
+            for j, sd, sq in zip(self.joints, self.dof_slices.values(), self.q_slices.values()):
+                if j.kind == SPHERICAL:
+                    sph_dof.append(list(range(sd.start, sd.stop)))
+                    sph_q.append(list(range(sq.start, sq.stop)))
+                else:
+                    rev_dof += list(range(sd.start, sd.stop))
+                    rev_q += list(range(sq.start, sq.stop))
+            cached = (np.array(sph_dof, dtype=int).reshape(-1, 3), np.array(sph_q, dtype=int).reshape(-1, 4),
+                      np.array(rev_dof, dtype=int), np.array(rev_q, dtype=int))
+            object.__setattr__(self, "_columns", cached)
+        return cached
 
     def reflect_quat(self, q: np.ndarray) -> np.ndarray:
         """Reflect rotations ``(..., 4)`` across the sagittal plane: ``M R M``, ``M`` = diag with

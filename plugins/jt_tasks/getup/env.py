@@ -310,6 +310,7 @@ class GetupEnv(CharacterEnv):
         success = reached_end and self.stand_t >= spec.success_window - 1e-9
         standing = self.start_kind == "standing"
         info: dict[str, Any] = {"reason": reason, "success": float(success and not standing),
+                                "early": float(not reached_end),
                                 "got_up": float(self.got_up and not standing),
                                 "standing_success": float(success and standing),
                                 "start_kind": float(START_KINDS.index(self.start_kind)),

@@ -29,7 +29,8 @@ from jt_tasks.getup.config import GetupConfig
 from jt_tasks.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
-HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate")  #: per-iteration episode means
+#: per-iteration episode means (``early``: the share ended by 003 §5.3's early termination)
+HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate", "early")
 
 
 class GetupTask(PolicyTask):
@@ -141,7 +142,10 @@ class GetupTask(PolicyTask):
             row = [float(samples)] + [float(np.mean([e.get(k, 0.0) for e in fallen_eps])) if fallen_eps else math.nan
                                       for k in HISTORY]
             prev = np.asarray(extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
-            extra["getup_history"] = np.vstack([prev.reshape(-1, 1 + len(HISTORY)), [row]])
+            prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
+            if prev.shape[1] < 1 + len(HISTORY):  # a run resumed from before a column was added
+                prev = np.hstack([prev, np.full((len(prev), 1 + len(HISTORY) - prev.shape[1]), math.nan)])
+            extra["getup_history"] = np.vstack([prev, [row]])
             if progress is not None:
                 progress(min(samples / max(total, 1), 1.0), f"success {row[1]:.2f}")
             return out
@@ -225,9 +229,9 @@ class GetupTask(PolicyTask):
                 metrics["terrain_level"] = float(level)
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         hist = np.asarray(res.extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
-        hist = hist.reshape(-1, 1 + len(HISTORY))
+        hist = hist.reshape(len(hist), -1) if hist.size else np.zeros((0, 1 + len(HISTORY)))
         history = {"mean_return": return_curve(trained)}
-        for col, key in enumerate(HISTORY, start=1):
+        for col, key in enumerate(HISTORY[:hist.shape[1] - 1], start=1):
             history[f"train_{key}"] = [(int(r[0]), float(r[col])) for r in hist if math.isfinite(r[col])]
         return Evaluation(metrics=metrics, history=history)
 
