@@ -41,6 +41,7 @@ PROTOTYPES: dict[str, tuple[Any, tuple[Any, ...]]] = {
     "b3SetClosestDistanceThreshold": (None, (I64, F64)),
     "b3CanSubmitCommand": (I32, (I64,)),
     "b3GetNumBodies": (I32, (I64,)),
+    "b3GetLinkState": (I32, (I64, I64, I32, I64)),
 }
 
 #: EnumSharedMemoryServerStatus values (Bullet's SharedMemoryPublic.h); ``handle`` confirms the

@@ -79,6 +79,7 @@ class CompiledSteps:
         self.cinfo = np.zeros(2, i64)
         self.cinfo32 = self.cinfo.view(np.int32)
         self.pts = np.zeros(capi.POINT_WORDS * 1024, np.int32)
+        self.ls = np.zeros(fastloop.LINK_STATE_DOUBLES)
         self.method = _KERNELS[be.method]
         self.tol = float(getattr(be, "tol", 1e-12))
         self.max_iter = int(getattr(be, "max_iter_factor", 20)) * m.n_v
@@ -129,6 +130,14 @@ class CompiledSteps:
         self.fl.read_state(self.fns, self.h, self.body, self.holder, self.bq, self.bu, self.qmap,
                            self.umap, io.q, io.qd)
         return io.q, io.qd
+
+    def link_states(self) -> tuple[np.ndarray, np.ndarray]:
+        """New arrays: centre-of-mass positions ``(n_links + 1, 3)`` and orientations
+        ``(n_links + 1, 4)`` of the base and every link (``SceneQueries.link_states``)."""
+        pos = np.empty((self._n_links + 1, 3))
+        orn = np.empty((self._n_links + 1, 4))
+        self.fl.link_states(self.fns, self.h, self.body, self.holder, self.ls, pos, orn)
+        return pos, orn
 
     def step(self, qt: np.ndarray, vt: Optional[np.ndarray], n: int,
              watch: Optional[Watch]) -> tuple[int, dict[str, Any]]:

@@ -82,13 +82,15 @@ _C = (
     ("b3SetClosestDistanceThreshold", _c_call(_void, _i64, _f64)),
     ("memcpy", _c_call(_i64, _i64, _i64, _i64)),
     ("clock_gettime", _c_call(_i32, _i32, _i64)),
+    ("b3GetLinkState", _c_call(_i32, _i64, _i64, _i32, _i64)),
 )
 (_submit, _status_type, _step_init, _state_init, _actual_state, _control_init, _set_forces,
  _contact_init, _contact_filter_a, _contact_info, _closest_init, _closest_a, _closest_b,
- _closest_threshold, _memcpy, _clock) = (c for _n, c in _C)
+ _closest_threshold, _memcpy, _clock, _link_state) = (c for _n, c in _C)
 (SUBMIT, STATUS_TYPE, STEP_INIT, STATE_INIT, ACTUAL_STATE, CONTROL_INIT, SET_FORCES, CONTACT_INIT,
  CONTACT_FILTER_A, CONTACT_INFO, CLOSEST_INIT, CLOSEST_A, CLOSEST_B, CLOSEST_THRESHOLD, MEMCPY,
- CLOCK) = range(len(_C))
+ CLOCK, LINK_STATE) = range(len(_C))
+LINK_STATE_DOUBLES = 33  #: sizeof(struct b3LinkState) / 8 (SharedMemoryPublic.h)
 
 
 def funcs() -> np.ndarray:
@@ -120,6 +122,27 @@ def read_state(fns, h, body, holder, bq, bu, qmap, umap, q, qd) -> None:
         q[i] = bq[qmap[i]]
     for i in range(qd.shape[0]):
         qd[i] = bu[umap[i]]
+
+
+@njit(cache=True)
+def link_states(fns, h, body, holder, ls, pos, orn) -> None:
+    """World centre-of-mass positions ``pos`` ``(n_links + 1, 3)`` and orientations ``orn``
+    ``(n_links + 1, 4)`` of the base and every link, as PyBullet's getBasePositionAndOrientation and
+    getLinkStates report them (the same request and the same fields)."""
+    status = _submit(fns[SUBMIT], (h, _state_init(fns[STATE_INIT], (h, body))))
+    hp = holder.ctypes.data
+    _actual_state(fns[ACTUAL_STATE], (status, 0, 0, 0, 0, hp, 0, 0))
+    _memcpy(fns[MEMCPY], (ls.ctypes.data, holder[0], 7 * 8))
+    for i in range(3):
+        pos[0, i] = ls[i]
+    for i in range(4):
+        orn[0, i] = ls[3 + i]
+    for link in range(pos.shape[0] - 1):
+        _link_state(fns[LINK_STATE], (h, status, link, ls.ctypes.data))
+        for i in range(3):
+            pos[link + 1, i] = ls[i]
+        for i in range(4):
+            orn[link + 1, i] = ls[3 + i]
 
 
 @njit(cache=True)

@@ -44,6 +44,9 @@ class SceneQueries:
         import pybullet as pb
 
         kw, b = {"physicsClientId": self.client}, self.character.body_id
+        compiled = getattr(self, "_compiled", None)
+        if compiled and not base_only:  # the same request and fields through the C API
+            return compiled.link_states()
         pos, orn = pb.getBasePositionAndOrientation(b, **kw)
         if base_only:
             return np.array([pos]), np.array([orn])

@@ -184,3 +184,19 @@ def test_the_c_handle_is_the_clients_own():
     finally:
         a.close()
         b.close()
+
+
+def test_link_states_through_the_c_api_are_pybullets():
+    a, b = make("python"), make("compiled")
+    try:
+        episode(a, 6)
+        episode(b, 6)
+        pa, oa = a.link_states()
+        pb_, ob = b.link_states()
+        assert pa.shape == (a.n_links + 1, 3) and ob.shape == (a.n_links + 1, 4)
+        assert np.array_equal(pa, pb_) and np.array_equal(oa, ob)
+        assert np.array_equal(b.link_states(base_only=True)[0], pb_[:1])
+        assert not np.array_equal(pa[1], pa[2])  # real link positions, not one row repeated
+    finally:
+        a.close()
+        b.close()
