@@ -42,6 +42,7 @@ PROTOTYPES: dict[str, tuple[Any, tuple[Any, ...]]] = {
     "b3CanSubmitCommand": (I32, (I64,)),
     "b3GetNumBodies": (I32, (I64,)),
     "b3GetLinkState": (I32, (I64, I64, I32, I64)),
+    "b3RequestActualStateCommandComputeForwardKinematics": (I32, (I64, I32)),
 }
 
 #: EnumSharedMemoryServerStatus values (Bullet's SharedMemoryPublic.h); ``handle`` confirms the

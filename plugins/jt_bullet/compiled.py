@@ -139,6 +139,14 @@ class CompiledSteps:
         self.fl.link_states(self.fns, self.h, self.body, self.holder, self.ls, pos, orn)
         return pos, orn
 
+    def link_frames(self, links: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """New arrays: URDF-frame positions ``(n, 3)`` and orientations ``(n, 4)`` of ``links``
+        ``(n,)`` int64 (-1: the base), by forward kinematics (``SceneQueries.link_poses``)."""
+        pos = np.empty((len(links), 3))
+        orn = np.empty((len(links), 4))
+        self.fl.link_frames(self.fns, self.h, self.body, self.holder, self.ls, links, pos, orn)
+        return pos, orn
+
     def step(self, qt: np.ndarray, vt: Optional[np.ndarray], n: int,
              watch: Optional[Watch]) -> tuple[int, dict[str, Any]]:
         """Run ``n`` substeps towards ``qt``; ``(substeps done, the watch's result)`` with the

@@ -83,13 +83,14 @@ _C = (
     ("memcpy", _c_call(_i64, _i64, _i64, _i64)),
     ("clock_gettime", _c_call(_i32, _i32, _i64)),
     ("b3GetLinkState", _c_call(_i32, _i64, _i64, _i32, _i64)),
+    ("b3RequestActualStateCommandComputeForwardKinematics", _c_call(_i32, _i64, _i32)),
 )
 (_submit, _status_type, _step_init, _state_init, _actual_state, _control_init, _set_forces,
  _contact_init, _contact_filter_a, _contact_info, _closest_init, _closest_a, _closest_b,
- _closest_threshold, _memcpy, _clock, _link_state) = (c for _n, c in _C)
+ _closest_threshold, _memcpy, _clock, _link_state, _with_fk) = (c for _n, c in _C)
 (SUBMIT, STATUS_TYPE, STEP_INIT, STATE_INIT, ACTUAL_STATE, CONTROL_INIT, SET_FORCES, CONTACT_INIT,
  CONTACT_FILTER_A, CONTACT_INFO, CLOSEST_INIT, CLOSEST_A, CLOSEST_B, CLOSEST_THRESHOLD, MEMCPY,
- CLOCK, LINK_STATE) = range(len(_C))
+ CLOCK, LINK_STATE, WITH_FK) = range(len(_C))
 LINK_STATE_DOUBLES = 33  #: sizeof(struct b3LinkState) / 8 (SharedMemoryPublic.h)
 
 
@@ -143,6 +144,31 @@ def link_states(fns, h, body, holder, ls, pos, orn) -> None:
             pos[link + 1, i] = ls[i]
         for i in range(4):
             orn[link + 1, i] = ls[3 + i]
+
+
+@njit(cache=True)
+def link_frames(fns, h, body, holder, ls, links, pos, orn) -> None:
+    """World positions ``pos`` ``(n, 3)`` and orientations ``orn`` ``(n, 4)`` of the URDF frames of
+    ``links`` ``(n,)`` (-1: the base) by forward kinematics of the current state, as PyBullet's
+    getLinkState(computeForwardKinematics=True) and getBasePositionAndOrientation report them."""
+    cmd = _state_init(fns[STATE_INIT], (h, body))
+    _with_fk(fns[WITH_FK], (cmd, 1))
+    status = _submit(fns[SUBMIT], (h, cmd))
+    hp = holder.ctypes.data
+    for k in range(links.shape[0]):
+        if links[k] < 0:
+            _actual_state(fns[ACTUAL_STATE], (status, 0, 0, 0, 0, hp, 0, 0))
+            _memcpy(fns[MEMCPY], (ls.ctypes.data, holder[0], 7 * 8))
+            for i in range(3):
+                pos[k, i] = ls[i]
+            for i in range(4):
+                orn[k, i] = ls[3 + i]
+        else:
+            _link_state(fns[LINK_STATE], (h, status, links[k], ls.ctypes.data))
+            for i in range(3):
+                pos[k, i] = ls[14 + i]  # m_worldLinkFramePosition
+            for i in range(4):
+                orn[k, i] = ls[17 + i]  # m_worldLinkFrameOrientation
 
 
 @njit(cache=True)

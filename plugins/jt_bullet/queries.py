@@ -69,7 +69,8 @@ class SceneQueries:
 
     def com(self) -> np.ndarray:
         """The character's centre of mass ``(3,)`` now (forward kinematics of the current state)."""
-        q, _ = self.io.read()
+        compiled = getattr(self, "_compiled", None)
+        q, _ = compiled.read() if compiled else self.io.read()
         return self.com_now(q)
 
     def com_now(self, q: np.ndarray) -> np.ndarray:
@@ -98,12 +99,24 @@ class SceneQueries:
         import pybullet as pb
 
         kw, b = {"physicsClientId": self.client}, self.character.body_id
+        compiled = getattr(self, "_compiled", None)
+        if compiled:  # the same request and fields through the C API
+            pos, orn = compiled.link_frames(np.array([int(link)], dtype=np.int64))
+            return pos[0], orn[0]
         if link < 0:
             pos, orn = pb.getBasePositionAndOrientation(b, **kw)
         else:
             s = pb.getLinkState(b, link, computeForwardKinematics=True, **kw)
             pos, orn = s[4], s[5]
         return np.array(pos), np.array(orn)
+
+    def link_poses(self, links: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+        """``link_pose`` of ``links``: positions ``(n, 3)``, orientations ``(n, 4)`` (one C API
+        request for all of them where the compiled loop runs)."""
+        compiled = getattr(self, "_compiled", None)
+        if compiled:
+            return compiled.link_frames(np.asarray(links, dtype=np.int64).reshape(-1))
+        return super().link_poses(links)  # Simulator's: link_pose for each
 
     def aabb(self, link: int) -> tuple[np.ndarray, np.ndarray]:
         """World AABB ``(low (3,), high (3,))`` of a link (-1: the base)."""

@@ -184,6 +184,14 @@ class Simulator(Plugin, abc.ABC):
         """
         raise NotImplementedError
 
+    def link_poses(self, links: "Sequence[int]") -> tuple["np.ndarray", "np.ndarray"]:
+        """``link_pose`` of several links at once: positions ``(n, 3)`` and orientations ``(n, 4)``
+        (a simulator may answer them with one query; this default calls ``link_pose`` for each)."""
+        import numpy as np
+
+        poses = [self.link_pose(int(k)) for k in links]
+        return (np.array([p for p, _ in poses]).reshape(-1, 3), np.array([o for _, o in poses]).reshape(-1, 4))
+
     def com(self) -> "np.ndarray":
         """The character's centre of mass ``(3,)``."""
         pos, _ = self.link_states()

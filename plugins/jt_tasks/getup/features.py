@@ -93,9 +93,7 @@ def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0) 
         the ground at each grid point, ``003`` §3.2), ``ground`` ``(n * n,)`` terrain heights,
         ``neck``, ``r_hip``, ``l_hip`` ``(3,)``.
     """
-    neck = sim.link_pose(NECK_LINK)[0]
-    r_hip = sim.link_pose(RIGHT_HIP_LINK)[0]
-    l_hip = sim.link_pose(LEFT_HIP_LINK)[0]
+    neck, r_hip, l_hip = sim.link_poses((NECK_LINK, RIGHT_HIP_LINK, LEFT_HIP_LINK))[0]
     hips = 0.5 * (r_hip + l_hip)
     yaw = heading_yaw(neck, r_hip, l_hip)
     pts = heightmap_points(hips, yaw, n, spacing)

@@ -58,22 +58,42 @@ class BodyState:
     ee: np.ndarray
 
 
+def _joint_columns(skeleton: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For ``difference``: the joint-channel positions and quaternion columns ``(n, 4)`` of the
+    spherical joints, the channel positions and columns of the revolute ones (fixed joints, the
+    wrists, are neither and stay 0); cached on the skeleton."""
+    cached = skeleton.__dict__.get("_bound_columns")
+    if cached is None:
+        by_name = {j.name: (j, s) for j, s in zip(skeleton.joints, skeleton.q_slices.values())}
+        sph_at, sph_cols, rev_at, rev_cols = [], [], [], []
+        for k, name in enumerate(joint_channels(skeleton)):
+            if name not in by_name:
+                continue
+            j, s = by_name[name]
+            if j.kind == "spherical":
+                sph_at.append(k)
+                sph_cols.append(list(range(s.start, s.stop)))
+            else:
+                rev_at.append(k)
+                rev_cols.append(s.start)
+        cached = (np.array(sph_at, dtype=int), np.array(sph_cols, dtype=int).reshape(-1, 4),
+                  np.array(rev_at, dtype=int), np.array(rev_cols, dtype=int))
+        object.__setattr__(skeleton, "_bound_columns", cached)
+    return cached
+
+
 def difference(skeleton: Any, a: BodyState, b: BodyState) -> np.ndarray:
     """The 22-channel difference vector ``(n_channels,)`` between two states (all >= 0)."""
-    out = [np.abs(np.asarray(a.com, dtype=float) - np.asarray(b.com, dtype=float))]
-    out.append([float(rot.quat_angle(a.q[3:7], b.q[3:7]))])
+    com = np.abs(np.asarray(a.com, dtype=float) - np.asarray(b.com, dtype=float)).reshape(-1)
+    root = float(rot.quat_angle(a.q[3:7], b.q[3:7]))
     ja, jb = np.asarray(a.q[7:], dtype=float), np.asarray(b.q[7:], dtype=float)
-    by_name = {j.name: (j, s) for j, s in zip(skeleton.joints, skeleton.q_slices.values())}
-    angles = []
-    for name in joint_channels(skeleton):
-        if name not in by_name:  # a fixed joint (the wrists)
-            angles.append(0.0)
-            continue
-        j, s = by_name[name]
-        angles.append(float(rot.quat_angle(ja[s], jb[s])) if j.kind == "spherical" else abs(float(ja[s][0] - jb[s][0])))
-    out.append(angles)
-    out.append(np.linalg.norm(np.asarray(a.ee, dtype=float) - np.asarray(b.ee, dtype=float), axis=-1))
-    return np.concatenate([np.asarray(x, dtype=float).reshape(-1) for x in out])
+    sph_at, sph_cols, rev_at, rev_cols = _joint_columns(skeleton)
+    angles = np.zeros(len(joint_channels(skeleton)))
+    if len(sph_at):  # every spherical joint in one call (row-wise: the same as one call each)
+        angles[sph_at] = rot.quat_angle(ja[sph_cols], jb[sph_cols])
+    angles[rev_at] = np.abs(ja[rev_cols] - jb[rev_cols])
+    ee = np.linalg.norm(np.asarray(a.ee, dtype=float) - np.asarray(b.ee, dtype=float), axis=-1).reshape(-1)
+    return np.concatenate([com, [root], angles, ee])
 
 
 def _off(value: Any) -> bool:

@@ -142,7 +142,7 @@ class SpacetimeEnv(CharacterEnv):
     def body_state(self) -> bd.BodyState:
         """What the bounds compare of the simulated character now."""
         q, _ = self.sim.state()
-        ee = np.array([self.sim.link_pose(i)[0] for i in END_EFFECTORS])
+        ee = self.sim.link_poses(END_EFFECTORS)[0]
         return bd.BodyState(q, np.asarray(self.sim.com(), dtype=float), heading_frame(q, ee, self.axis))
 
     def difference(self) -> np.ndarray:
@@ -213,7 +213,7 @@ class SpacetimeEnv(CharacterEnv):
         acc = np.zeros_like(vel) if self._vel_prev is None else (vel - self._vel_prev) * self.control_hz
         jacc = np.zeros(len(qd) - 6) if self._qd_prev is None else (qd[6:] - self._qd_prev[6:]) * self.control_hz
         self._vel_prev, self._qd_prev = vel, qd.copy()
-        joints = np.array([self.sim.link_pose(i)[0] for i in range(self.n_links)])
+        joints = self.sim.link_poses(range(self.n_links))[0]
         record = {"q": q, "qd": qd, "link_pos": pos, "link_vel": vel, "link_acc": acc, "joint_acc": jacc,
                   "joint_pos": joints, "masses": self.masses, "clip": self.spec_.clip}
         out = 1.0

@@ -174,12 +174,15 @@ class SpacetimeReference:
         c = self.clip
         root_pos = (1 - f) * c.root_pos[i] + f * c.root_pos[i + 1] + k * self.offset
         root_pos = root_pos + np.array([0.0, self.lift, 0.0])
-        root_rot = rot.quat_normalize(rot.quat_slerp(c.root_rot[i], c.root_rot[i + 1], f))
         a, b = c.joints[i], c.joints[i + 1]
         joints = (1 - f) * a + f * b
-        for j, s in zip(self.skeleton.joints, self.skeleton.q_slices.values()):
-            if j.kind == "spherical":
-                joints[s] = rot.quat_normalize(rot.quat_slerp(a[s], b[s], f))
+        sph = self.skeleton._conversion_columns()[1]  # (n_spherical, 4) quaternion columns
+        # the root and every spherical joint in one slerp (row-wise: the same as one call each)
+        rots = rot.quat_normalize(rot.quat_slerp(np.vstack([c.root_rot[i], a[sph]]),
+                                                 np.vstack([c.root_rot[i + 1], b[sph]]), f))
+        root_rot = rots[0]
+        if len(sph):
+            joints[sph] = rots[1:]
         qd = np.zeros(self._vel.shape[1]) if held else (1 - f) * self._vel[i] + f * self._vel[i + 1]
         com = (1 - f) * self._com[i] + f * self._com[i + 1] + k * self.offset
         ee = (1 - f) * self._ee[i] + f * self._ee[i + 1]

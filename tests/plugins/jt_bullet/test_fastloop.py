@@ -200,3 +200,27 @@ def test_link_states_through_the_c_api_are_pybullets():
     finally:
         a.close()
         b.close()
+
+
+def test_link_frames_through_the_c_api_are_pybullets_forward_kinematics():
+    import pybullet as pb
+
+    b = make("compiled")
+    try:
+        episode(b, 4)
+        q, qd = b.state()
+        q[0] += 0.3
+        b.reset(q, qd)  # after a reset, before a step: forward kinematics of the new state
+        links = [-1, 0, 5, 11, 8, 14]
+        pos, orn = b.link_poses(links)
+        for k, link in enumerate(links):
+            if link < 0:
+                ref = pb.getBasePositionAndOrientation(b.character.body_id, physicsClientId=b.client)
+            else:
+                s = pb.getLinkState(b.character.body_id, link, computeForwardKinematics=True,
+                                    physicsClientId=b.client)
+                ref = s[4], s[5]
+            assert np.array_equal(pos[k], ref[0]) and np.array_equal(orn[k], ref[1])
+            assert np.array_equal(b.link_pose(link)[0], pos[k])
+    finally:
+        b.close()
