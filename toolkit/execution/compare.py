@@ -68,8 +68,16 @@ def metric_label(variant: str) -> str:
 
 
 def _params(overrides: Sequence[str], grid: list[tuple[str, list[str]]], seeds: int) -> dict[str, str]:
-    """The comparison's params: each base override ``base.<key>``, each ``vary.<key>``, ``seeds``."""
-    out = {f"base.{o.split('=', 1)[0]}": (o.split("=", 1)[1] if "=" in o else "") for o in overrides}
+    """The comparison's params: each base override ``base.<key>``, each ``vary.<key>``, ``seeds``.
+
+    Hydra's prefixes are not allowed in an MLflow key: ``~curriculum`` (delete a group) is
+    ``base.curriculum = ~``, ``+key=v`` / ``++key=v`` are ``base.key = v``."""
+    out = {}
+    for o in overrides:
+        key, value = (o.split("=", 1) + [""])[:2]
+        if key.startswith("~"):
+            key, value = key[1:], "~" + value
+        out[f"base.{key.lstrip('+')}"] = value
     out.update({f"vary.{k}": ",".join(v) for k, v in grid})
     out["seeds"] = str(seeds)
     return out
@@ -114,8 +122,8 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     run_id = store.start_run(experiment, run_name=store.unique_run_name(experiment, f"compare {label} x{seeds}"),
                              tags={**describe.provenance_tags(command), "jt.compare": "true", "jt.vary": label,
                                    "jt.seeds": str(seeds), describe.NOTE: f"Comparison running: `{command}`\n"})
-    store.log_params(run_id, _params(overrides, grid, seeds))
     try:
+        store.log_params(run_id, _params(overrides, grid, seeds))
         executor = plugins.load("executor", str(base.executor.name))(base.executor)
         parallel = executor.n_workers > 1 and len(cells) > 1
         results: list[Any] = [None] * len(cells)

@@ -100,3 +100,18 @@ def test_the_comparison_run_reads_well(example_plugin, store_dir):
     kid = store.get_run(tags["jt.compare.runs"].split(",")[-1])
     assert kid.data.tags["jt.command"] == f"jt run task=quadratic executor.workers=1 store={store_dir} " \
                                          "task.centre=0.5 seed=1"
+
+
+def test_hydra_prefixed_overrides_are_params_mlflow_takes(example_plugin, store_dir):
+    """``~group`` and ``+key=v`` are legal overrides but not legal MLflow keys: the comparison's
+    params name them without the prefix (``~curriculum`` used to end as an internal error with
+    the comparison run left RUNNING)."""
+    from toolkit.execution.compare import _params
+    from toolkit.store.tracking import Store
+
+    assert _params(["~curriculum", "+a.b=1", "++c=2", "seed=3"], [("x", ["1", "2"])], 2) == {
+        "base.curriculum": "~", "base.a.b": "1", "base.c": "2", "base.seed": "3", "vary.x": "1,2", "seeds": "2"}
+    res = compare(["task=quadratic", "~curriculum", "executor.workers=1", f"store={store_dir}"],
+                  ["task.centre=0.0,0.5"], seeds=1)
+    run = Store(store_dir).get_run(res.run_id)
+    assert run.info.status == "FINISHED" and run.data.params["base.curriculum"] == "~"
