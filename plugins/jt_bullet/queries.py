@@ -69,8 +69,7 @@ class SceneQueries:
 
     def com(self) -> np.ndarray:
         """The character's centre of mass ``(3,)`` now (forward kinematics of the current state)."""
-        compiled = getattr(self, "_compiled", None)
-        q, _ = compiled.read() if compiled else self.io.read()
+        q, _ = self.state()
         return self.com_now(q)
 
     def com_now(self, q: np.ndarray) -> np.ndarray:

@@ -118,6 +118,7 @@ class BulletSimulator(SceneQueries, Simulator):
         self.step_log: list | None = None
         self._last: dict[str, Any] = {}
         self._compiled: Any = None  # jt_bullet.compiled.CompiledSteps, False: the Python loop
+        self._state_read = False  # io.q, io.qd hold the current state (the compiled loop's last read)
         if p.loop not in ("auto", "compiled", "python"):
             self.close()
             raise JtError(f"sim.loop={p.loop!r}: choose auto, compiled or python")
@@ -222,10 +223,18 @@ class BulletSimulator(SceneQueries, Simulator):
         self.reason = ""
         self._tau[:] = 0.0
         self._last = {}
+        self._state_read = False  # PyBullet may store q differently (a normalised quaternion): read it
 
     def state(self) -> tuple[np.ndarray, np.ndarray]:
-        """Current ``(q (n_q,), qd (n_dof,))`` (copies)."""
-        q, qd = self._compiled.read() if self._compiled else self.io.read()
+        """Current ``(q (n_q,), qd (n_dof,))`` (copies). With the compiled loop, the state its last
+        substep read (or the last read since a reset) is the current one: no second C API request."""
+        if self._compiled:
+            if not self._state_read:
+                self._compiled.read()
+                self._state_read = True
+            q, qd = self.io.q, self.io.qd
+        else:
+            q, qd = self.io.read()
         return q.copy(), qd.copy()
 
     def step(self, q_target: np.ndarray, qd_target: np.ndarray | None = None,
@@ -322,6 +331,7 @@ class BulletSimulator(SceneQueries, Simulator):
         t_start = time.perf_counter()
         cs.timers[:] = 0.0
         done, result = cs.step(qt, vt, n, watch)
+        self._state_read = True  # the loop read the state after its last substep into io.q, io.qd
         tm, ct = self.timers, cs.timers
         tm["spd_s"] += float(ct[fl.T_SPD])
         tm["substep_s"] += float(ct[fl.T_SUB])

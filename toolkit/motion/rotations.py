@@ -18,6 +18,8 @@ Every function is vectorised over leading dimensions: quaternions ``(..., 4)``, 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 _EPS = 1e-12
@@ -170,6 +172,9 @@ def quat_slerp(q0, q1, t) -> np.ndarray:
 
 def quat_to_matrix(q) -> np.ndarray:
     """Rotation matrices ``(..., 3, 3)`` of quaternions ``(..., 4)`` (normalised here)."""
+    q = _arr(q)
+    if q.shape == (4,):  # one quaternion (every env's per-step observation): Python floats, same bits
+        return _quat_to_matrix_one(q)
     x, y, z, w = np.moveaxis(quat_normalize(q), -1, 0)
     xx, yy, zz = x * x, y * y, z * z
     xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
@@ -182,6 +187,24 @@ def quat_to_matrix(q) -> np.ndarray:
         axis=-1,
     )  # fmt: skip
     return m.reshape(m.shape[:-1] + (3, 3))
+
+
+def _quat_to_matrix_one(q: np.ndarray) -> np.ndarray:
+    """``quat_to_matrix`` of one quaternion ``(4,)`` → ``(3, 3)``, bit for bit: the same operations
+    in the same order as the vectorised path (``quat_normalize``'s norm sums the squares left to
+    right, as numpy's reduction of four values does), on Python floats (~10x faster than numpy's
+    per-call overhead on 4 numbers)."""
+    x, y, z, w = q.tolist()
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    if n > _EPS:
+        x, y, z, w = x / n, y / n, z / n, w / n
+    else:
+        x, y, z, w = 0.0, 0.0, 0.0, 1.0
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
+    return np.array([[1 - 2 * (yy + zz), 2 * (xy - wz), 2 * (xz + wy)],
+                     [2 * (xy + wz), 1 - 2 * (xx + zz), 2 * (yz - wx)],
+                     [2 * (xz - wy), 2 * (yz + wx), 1 - 2 * (xx + yy)]])
 
 
 def matrix_to_quat(m) -> np.ndarray:

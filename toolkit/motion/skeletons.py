@@ -10,6 +10,7 @@ values (exponential map) per spherical joint: it is the PD-target layout (28 DoF
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 
 import numpy as np
@@ -92,14 +93,14 @@ class Skeleton:
     def joint_names(self) -> list[str]:
         return [j.name for j in self.joints]
 
-    @property
+    @functools.cached_property
     def n_q(self) -> int:
         """Width of the quaternion layout."""
         return sum(j.n_q for j in self.joints)
 
-    @property
+    @functools.cached_property
     def n_dof(self) -> int:
-        """Width of the dof layout (internal DoFs)."""
+        """Width of the dof layout (internal DoFs; cached: every action checks its size with it)."""
         return sum(j.n_dof for j in self.joints)
 
     @property

@@ -65,7 +65,7 @@ def canonical_expmaps(skeleton: Skeleton, dofs: np.ndarray) -> np.ndarray:
     if idx.size:
         v = out[..., idx]  # (..., n_spherical, 3)
         big = np.einsum("...i,...i->...", v, v) > np.pi**2
-        if np.any(big):
+        if big.any():
             out[..., idx] = np.where(big[..., None], rot.quat_to_expmap(rot.quat_from_expmap(v)), v)
     return out
 

@@ -17,6 +17,7 @@ orientation (slerp) at the zero crossing.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any, Optional
 
@@ -38,9 +39,18 @@ def suite_orientation(q_root: np.ndarray, suite_rotation: np.ndarray) -> np.ndar
         q_root: world root orientation ``(4,)``.
         suite_rotation: suite axes as columns ``(3, 3)`` (``Suite.rotation()``).
     """
-    q_suite = rot.matrix_to_quat(np.asarray(suite_rotation, dtype=float))
+    q_suite = _suite_quat(np.asarray(suite_rotation, dtype=float).tobytes())
     q = rot.quat_multiply(rot.quat_conjugate(q_suite), np.asarray(q_root, dtype=float))
     return rot.quat_canonical(rot.quat_normalize(q))
+
+
+@functools.lru_cache(maxsize=64)
+def _suite_quat(rotation: bytes) -> np.ndarray:
+    """``matrix_to_quat`` of a suite rotation ``(3, 3)`` given as its bytes (an episode's end asks
+    for the same few frames again and again); read-only."""
+    q = rot.matrix_to_quat(np.frombuffer(rotation, dtype=np.float64).reshape(3, 3))
+    q.flags.writeable = False
+    return q
 
 
 def angle_distance(a: Any, b: Any) -> np.ndarray:
@@ -112,6 +122,9 @@ class CrossingTracker:
             self._prev = (float(times[-1]), float(signed_distances[-1]), np.asarray(q_roots[-1], dtype=float).copy())
             return False
         d = np.asarray(signed_distances, dtype=float)
+        if d.max() < 0.0:  # all before the plane (the common case; NaN takes the general path)
+            self._prev = (float(times[-1]), float(d[-1]), np.asarray(q_roots[-1], dtype=float).copy())
+            return False
         before = np.concatenate([[self._prev[1] if self._prev is not None else np.nan], d[:-1]])
         hits = np.flatnonzero((before < 0.0) & (d >= 0.0))
         if len(hits) == 0:

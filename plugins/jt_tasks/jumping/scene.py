@@ -83,6 +83,8 @@ class Suite:
             else np.array([1.0, 0.0, 0.0])
         self.up = np.array([0.0, 1.0, 0.0])
         self.along = np.cross(self.normal, self.up)
+        self._rotation = np.stack([self.normal, self.up, self.along], axis=1)
+        self._rotation.flags.writeable = False  # shared by every caller of rotation()
         if spec.kind == "highjump":
             self.near, self.far = spec.distance - spec.wall_thickness / 2, spec.distance + spec.wall_thickness / 2
             self.barrier_height = spec.bar_height
@@ -151,11 +153,12 @@ class Suite:
 
     def to_local(self, v: np.ndarray) -> np.ndarray:
         """World vectors ``(..., 3)`` in the suite frame (normal, up, along) ``(..., 3)``."""
-        return np.asarray(v) @ np.stack([self.normal, self.up, self.along], axis=1)
+        return np.asarray(v) @ self._rotation
 
     def rotation(self) -> np.ndarray:
-        """Suite frame axes as columns ``(3, 3)`` (right-handed: normal × up = along)."""
-        return np.stack([self.normal, self.up, self.along], axis=1)
+        """Suite frame axes as columns ``(3, 3)`` (right-handed: normal × up = along), read-only:
+        made once per frame (the observation reads it every control step)."""
+        return self._rotation
 
     def near_barrier(self, margin: float) -> bool:
         """True when any part of the character is within ``margin`` of the wall / obstacle."""

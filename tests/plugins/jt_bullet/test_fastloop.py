@@ -224,3 +224,28 @@ def test_link_frames_through_the_c_api_are_pybullets_forward_kinematics():
             assert np.array_equal(b.link_pose(link)[0], pos[k])
     finally:
         b.close()
+
+
+def test_state_after_a_compiled_step_is_pybullets_without_a_second_read():
+    """``state()`` after a compiled step returns the loop's last read (no C API request); it is
+    PyBullet's state to the bit, and a reset makes the next ``state()`` read PyBullet again."""
+    import pybullet as pb
+
+    sim = make("compiled")
+    try:
+        episode(sim, 5)
+        assert sim._state_read
+        q, qd = sim.state()
+        q2, qd2 = sim._compiled.read()  # a fresh request through the C API
+        assert np.array_equal(q, q2) and np.array_equal(qd, qd2)
+        base = pb.getBasePositionAndOrientation(sim.character.body_id, physicsClientId=sim.client)
+        assert np.array_equal(q[:3], base[0]) and np.array_equal(q[3:7], base[1])
+        q[3:7] *= 2.0  # not a unit quaternion: PyBullet stores it normalised
+        sim.reset(q, qd)
+        assert not sim._state_read
+        stored, _ = sim.state()
+        assert np.allclose(np.linalg.norm(stored[3:7]), 1.0) and sim._state_read
+        stored[0] += 1.0  # a copy: the cache is not changed through it
+        assert not np.array_equal(sim.state()[0], stored)
+    finally:
+        sim.close()

@@ -166,3 +166,16 @@ def test_normalize_canonical_align():
     aligned = rot.align_hemisphere(flipped)
     assert np.all(np.sum(aligned[1:] * aligned[:-1], axis=1) > 0)
     assert same_rotation(aligned, seq)
+
+
+def test_one_quaternion_to_matrix_is_the_vectorised_result_bit_for_bit():
+    """``quat_to_matrix`` of one ``(4,)`` quaternion takes a Python-float path (the per-step
+    observation's); it must be the batched path's result exactly, tiny and zero quaternions too."""
+    rng = np.random.default_rng(0)
+    for scale in (1e-13, 1e-6, 1.0, 1e4):
+        qs = rng.standard_normal((2000, 4)) * scale
+        batched = rot.quat_to_matrix(qs)
+        for q, m in zip(qs, batched):
+            assert np.array_equal(rot.quat_to_matrix(q), m)
+    assert np.array_equal(rot.quat_to_matrix(np.zeros(4)), np.eye(3))
+    assert rot.quat_to_matrix([0.0, 0.0, 0.0, 1.0]).shape == (3, 3)
