@@ -47,6 +47,17 @@ def obs_value(obs: Any, key: str) -> Any:
     return getattr(obs, key, None)
 
 
+class FilterCheck:
+    """Mixin of every built-in action space's ``Config``: ``beta`` in (0, 1], checked at composition."""
+
+    def check(self) -> None:
+        from toolkit.schema import require
+
+        beta = getattr(self, "beta", 1.0)
+        require(isinstance(beta, (int, float)) and 0.0 < float(beta) <= 1.0, "action.beta", beta,
+                "a filter coefficient in (0, 1] (1: no filter)")
+
+
 class DofActionSpace(ActionSpace):
     """Base of jt's action spaces: PD targets in the character's dof layout, within joint limits.
 
@@ -63,6 +74,39 @@ class DofActionSpace(ActionSpace):
         skeleton = skeleton_of(character)
         super().__init__(cfg, skeleton)  # the interface validates cfg into self.params (one line on a mistake)
         self.skeleton = skeleton
+        beta = getattr(self.params, "beta", 1.0)
+        if not 0.0 < float(beta) <= 1.0:
+            raise JtError(f"action={self.params.name}: beta must be in (0, 1] (1: no filter), got {beta}")
+        self._y: np.ndarray | None = None
+
+    # ---- the action filter (003 §3.4, after DReCon): an option of every action space -------------
+    @property
+    def beta(self) -> float:
+        """Filter coefficient: ``y_t = β a_t + (1 - β) y_{t-1}``; 1 is no filter."""
+        return float(getattr(self.params, "beta", 1.0))
+
+    @property
+    def filtered(self) -> np.ndarray | None:
+        """The filtered action ``y_{t-1}`` ``(dim,)`` (part of the get-up policy's observation,
+        ``003`` §3.3), or None without a filter (β = 1: the task uses the action itself)."""
+        if self.beta == 1.0:
+            return None
+        return np.zeros(self.dim) if self._y is None else self._y.copy()
+
+    def filter(self, action: np.ndarray) -> np.ndarray:
+        """Advance the filter with ``action`` ``(dim,)``; returns ``y_t`` (``action`` itself, as a
+        float array, when β = 1)."""
+        a = self.check_action(action)
+        b = self.beta
+        if b == 1.0:
+            return a
+        prev = np.zeros(self.dim) if self._y is None else self._y
+        self._y = b * a + (1.0 - b) * prev
+        return self._y.copy()
+
+    def reset_filter(self, state: Any = None) -> None:
+        """New episode: ``y_{-1} = state`` ``(dim,)``, or zeros."""
+        self._y = None if state is None else self.check_action(state).copy()
 
     @property
     def n_dof(self) -> int:

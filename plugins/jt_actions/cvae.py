@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from jt_actions.base import naturalness, obs_value
+from jt_actions.base import FilterCheck, naturalness, obs_value
 from jt_actions.pvae import PVAEActionSpace
 from toolkit.errors import JtError
 
@@ -30,7 +30,7 @@ class CVAEActionSpace(PVAEActionSpace):
     kind = "cvae"
 
     @dataclasses.dataclass
-    class Config:
+    class Config(FilterCheck):
         name: str = "cvae"
         prior: str = "auto"
         """Prior.h5 path (or a folder with one), the MLflow run id of a pose_prior run, or "auto":
@@ -42,7 +42,7 @@ class CVAEActionSpace(PVAEActionSpace):
         offset_bound: float = 1.0
         """Ours: |dq'| bound per DoF (rad)."""
         beta: float = 0.2
-        """003 §3.4: action filter coefficient."""
+        """003 §3.4: action filter coefficient, y_t = beta a_t + (1 - beta) y_{t-1} (1: no filter)."""
         c: float = 10.0
         """003 eq 3: "a constant value of c = 10 was sufficient"."""
         clip_to_limits: bool = True
@@ -50,10 +50,7 @@ class CVAEActionSpace(PVAEActionSpace):
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)
-        if not 0.0 < self.params.beta <= 1.0:
-            raise JtError(f"action=cvae: beta must be in (0, 1], got {self.params.beta}")
         self._condition: np.ndarray | None = None
-        self._y = np.zeros(self.dim)
 
     def set_condition(self, c: Any) -> None:
         """The C-VAE condition ``(h, θ_side, θ_front)`` ``(3,)`` for the coming steps."""
@@ -65,17 +62,6 @@ class CVAEActionSpace(PVAEActionSpace):
     @property
     def condition(self) -> np.ndarray | None:
         return self._condition
-
-    @property
-    def filtered(self) -> np.ndarray:
-        """The filtered action ``y_{t-1}`` ``(dim,)`` (part of the policy's observation in ``003``)."""
-        return self._y.copy()
-
-    def filter(self, action: np.ndarray) -> np.ndarray:
-        """Advance the filter: ``y_t = β a_t + (1 - β) y_{t-1}``; returns ``y_t``."""
-        b = float(self.params.beta)
-        self._y = b * self.check_action(action) + (1.0 - b) * self._y
-        return self._y.copy()
 
     def targets(self, action: np.ndarray, obs: Any = None) -> np.ndarray:
         c = obs_value(obs, "condition")
@@ -91,7 +77,7 @@ class CVAEActionSpace(PVAEActionSpace):
     def reset(self, state: Any = None) -> None:
         """New episode: ``y_{-1} = state`` (``(dim,)``) or zeros; forget the offset norms."""
         super().reset(state)
-        self._y = np.zeros(self.dim) if state is None else self.check_action(state).copy()
+        self.reset_filter(state)
 
     def set_c_offset(self, c_offset: float) -> None:
         """The naturalness scale ``c`` of ``003`` eq 3 (constant 10 in the paper)."""

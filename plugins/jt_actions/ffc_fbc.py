@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from jt_actions.base import DofActionSpace, obs_value
+from jt_actions.base import DofActionSpace, FilterCheck, obs_value
 from toolkit.errors import JtError
 
 
@@ -56,7 +56,7 @@ class FFCFBCActionSpace(DofActionSpace):
     """Target = reference pose at the phase (feed-forward) + the policy's correction (002 §4.2)."""
 
     @dataclasses.dataclass
-    class Config:
+    class Config(FilterCheck):
         name: str = "ffc_fbc"
         clip: str = "walk"
         """Reference clip: a pybullet_data motion name (walk, run, backflip, ...) or a path."""
@@ -64,6 +64,9 @@ class FFCFBCActionSpace(DofActionSpace):
         """Ours: |dq| bound per DoF (rad); 002 gives none."""
         clip_to_limits: bool = True
         """Targets within the joint limits."""
+        beta: float = 1.0
+        """Action filter y_t = beta a_t + (1 - beta) y_{t-1} (003 §3.4's, an option of every action
+        space); 1: no filter (002 filters nothing)."""
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)
@@ -119,8 +122,9 @@ class FFCFBCActionSpace(DofActionSpace):
         phase = obs if isinstance(obs, Real) else obs_value(obs, "phase")
         if phase is not None:
             self.set_phase(float(phase))
-        return self.finish(self.reference() + self.check_action(action))
+        return self.finish(self.reference() + self.filter(action))
 
     def reset(self, state: Any = None) -> None:
-        """New episode: φ = ``state`` (a number) or 0."""
+        """New episode: φ = ``state`` (a number) or 0; the filter starts from zero."""
         self.set_phase(float(state) if state is not None else 0.0)
+        self.reset_filter(None)

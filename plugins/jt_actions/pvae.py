@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from jt_actions.base import DofActionSpace, naturalness
+from jt_actions.base import DofActionSpace, FilterCheck, naturalness
 from toolkit.errors import JtError
 
 
@@ -29,8 +29,11 @@ class PVAEActionSpace(DofActionSpace):
     kind = "pvae"
 
     @dataclasses.dataclass
-    class Config:
+    class Config(FilterCheck):
         name: str = "pvae"
+        beta: float = 1.0
+        """Action filter y_t = beta a_t + (1 - beta) y_{t-1} (003 §3.4's, an option of every action
+        space); 1: no filter (the papers' choice for this space)."""
         prior: str = "auto"
         """Prior.h5 path (or a folder with one), the MLflow run id of a pose_prior run, or "auto":
         the store's own prior, trained on first use from the shipped clips (``toolkit.priors.auto``)."""
@@ -83,13 +86,14 @@ class PVAEActionSpace(DofActionSpace):
         return self.prior.decode_targets(self.prior.latent_from_action(a_latent), condition)
 
     def targets(self, action: np.ndarray, obs: Any = None) -> np.ndarray:
-        a_lat, a_off = self.split(self.check_action(action))
+        a_lat, a_off = self.split(self.filter(action))
         self._norms.append(float(np.abs(a_off).sum()))
         return self.finish(self.natural_targets(a_lat) + a_off)
 
     def reset(self, state: Any = None) -> None:
-        """New episode: forget the offset norms."""
+        """New episode: forget the offset norms; the filter starts from zero."""
         self._norms = []
+        self.reset_filter(None)
 
     # ---- naturalness ---------------------------------------------------------------------------
     def set_c_offset(self, c_offset: float) -> None:

@@ -11,15 +11,18 @@ from typing import Any
 
 import numpy as np
 
-from jt_actions.base import DofActionSpace
+from jt_actions.base import DofActionSpace, FilterCheck
 
 
 class RawActionSpace(DofActionSpace):
     """Action = PD targets (exp map per spherical joint, angle per revolute one), within limits."""
 
     @dataclasses.dataclass
-    class Config:
+    class Config(FilterCheck):
         name: str = "raw"
+        beta: float = 1.0
+        """Action filter y_t = beta a_t + (1 - beta) y_{t-1} (003 §3.4's, an option of every action
+        space); 1: no filter (the papers' choice for this space)."""
         clip_to_limits: bool = True
         """Targets within the joint limits (URDF revolute ranges; |exp map| <= pi)."""
         around_start: bool = False
@@ -43,7 +46,8 @@ class RawActionSpace(DofActionSpace):
         return low.copy(), high.copy()
 
     def reset(self, state: Any = None) -> None:
-        """Nothing to clear: the raw space keeps no state but its anchor."""
+        """New episode: the filter starts from zero (the raw space keeps no other state but its anchor)."""
+        self.reset_filter(None)
 
     def anchor(self, q: np.ndarray) -> None:
         """Keep the initial pose's joint targets ``(n_dof,)`` (with ``around_start``)."""
@@ -51,7 +55,7 @@ class RawActionSpace(DofActionSpace):
             self._start = self.skeleton.joints_to_dofs(np.asarray(q, dtype=np.float64)[7:])
 
     def targets(self, action: np.ndarray, obs: Any = None) -> np.ndarray:
-        a = self.check_action(action)
+        a = self.filter(action)
         if self.params.around_start:
             if self._start is None:
                 raise RuntimeError("action=raw with around_start: anchor(q) is called after every reset")
