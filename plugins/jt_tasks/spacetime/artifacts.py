@@ -63,15 +63,17 @@ def plot_start_sampling(h: dict[str, np.ndarray], out: Path) -> Path:
 def com_height_data(env: Any, times: np.ndarray, com: np.ndarray, n_grid: int = 200) -> dict[str, np.ndarray]:
     """What ``com_bounds.png`` draws, from a rollout of ``env`` (still open): ``phase`` and
     ``com_y`` ``(n,)`` of the rollout's states, the reference's CoM height ``ref_phase`` /
-    ``ref_com_y`` ``(n_grid,)`` over one cycle and the channel's width ``width`` (inf: off)."""
+    ``ref_com_y`` ``(n_grid,)`` over one cycle and the channel's width ``width`` ``(n_grid,)`` there
+    (a phase table's, else constant; inf: off)."""
     ref = env.ref
     times = np.asarray(times, dtype=float).reshape(-1)
     phase = np.array([ref.phase(env.t0 + t) for t in times])
     grid = np.linspace(0.0, 1.0, n_grid)
     ref_y = np.array([ref.sample(g * ref.period).com[1] for g in grid])
-    width = float(env.widths[list(env.names).index("com_y")])
+    ch = list(env.names).index("com_y")
+    width = np.array([float(env.widths_at(g)[ch]) for g in grid])
     return {"phase": phase, "com_y": np.asarray(com, dtype=float).reshape(-1, 3)[:, 1], "ref_phase": grid,
-            "ref_com_y": ref_y, "width": np.array(width)}
+            "ref_com_y": ref_y, "width": width}
 
 
 def plot_com_bounds(d: dict[str, np.ndarray], out: Path, title: str = "") -> Path:
@@ -84,8 +86,9 @@ def plot_com_bounds(d: dict[str, np.ndarray], out: Path, title: str = "") -> Pat
 
     fig, ax = plt.subplots(figsize=(5, 3))
     ax.plot(d["ref_phase"], d["ref_com_y"], color="green", lw=1.5, label="reference")
-    w = float(d["width"])
-    if np.isfinite(w):
+    w = np.broadcast_to(np.asarray(d["width"], dtype=float), np.shape(d["ref_phase"]))
+    if np.isfinite(w).any():  # off (inf) stretches of a phase table are left blank
+        w = np.where(np.isfinite(w), w, np.nan)
         for sgn in (-1, 1):
             ax.plot(d["ref_phase"], d["ref_com_y"] + sgn * w, color="red", lw=1.0, label="bounds" if sgn > 0 else None)
     ax.scatter(d["phase"], d["com_y"], s=6, color="C0", label="policy", zorder=3)

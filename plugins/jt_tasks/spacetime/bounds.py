@@ -14,7 +14,9 @@ in the authors' order (research notes):
   ground-projected root in its own heading frame (m).
 
 Widths (002 §5.1): CoM 0.2 m, orientations (root and joints) 0.7 rad, end effectors 0.5 m; a
-width of ``inf`` / ``None`` switches a channel off.
+width of ``inf`` / ``None`` switches a channel off. A phase table (the authors' format, research
+notes) gives K rows of widths evenly over phase [0, 1], linearly interpolated at the clip's phase
+(``width_table``, ``widths_at``); every table the authors ship is constant.
 """
 
 from __future__ import annotations
@@ -100,6 +102,39 @@ def _off(value: Any) -> bool:
     return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isinf(value) and value > 0)
 
 
+def _width(where: str, v: Any) -> float:
+    """One width (``inf`` for off); a non-number or a width <= 0 is one ``JtError`` line."""
+    from toolkit.errors import JtError
+
+    if _off(v):
+        return math.inf
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise JtError(f"{where}={v!r}: a bound width must be a number > 0 (null or .inf: off)") from None
+    if not x > 0 or math.isnan(x):
+        raise JtError(f"{where}={v!r}: a bound width must be > 0 (null or .inf switches a channel off)")
+    return x
+
+
+def _override(skeleton: Any, w: np.ndarray, per_channel: Mapping[str, Any], where: str) -> np.ndarray:
+    """``w`` ``(n_channels,)`` with ``{channel or group name: width}`` applied (in place)."""
+    from toolkit.errors import JtError
+
+    names = channel_names(skeleton)
+    n_joint = len(joint_channels(skeleton))
+    groups = {"com": range(0, 3), "orientation": range(3, 4 + n_joint), "end_effector": range(4 + n_joint, len(names))}
+    for key, v in dict(per_channel or {}).items():
+        key = str(key)
+        if key in groups:
+            w[list(groups[key])] = _width(f"{where}.{key}", v)
+        elif key in names:
+            w[names.index(key)] = _width(f"{where}.{key}", v)
+        else:
+            raise JtError(f"{where}.{key}: unknown bound channel; one of: {', '.join(GROUPS + names)}")
+    return w
+
+
 def widths(skeleton: Any, com: Any = 0.2, orientation: Any = 0.7, end_effector: Any = 0.5,
            per_channel: Optional[Mapping[str, Any]] = None) -> np.ndarray:
     """Per-channel widths ``(n_channels,)`` (``inf``: off) from the group widths and overrides.
@@ -115,35 +150,54 @@ def widths(skeleton: Any, com: Any = 0.2, orientation: Any = 0.7, end_effector: 
     """
     from toolkit.errors import JtError
 
-    names = channel_names(skeleton)
     n_joint = len(joint_channels(skeleton))
-
-    def value(where: str, v: Any) -> float:
-        if _off(v):
-            return math.inf
-        try:
-            x = float(v)
-        except (TypeError, ValueError):
-            raise JtError(f"{where}={v!r}: a bound width must be a number > 0 (null or .inf: off)") from None
-        if not x > 0 or math.isnan(x):
-            raise JtError(f"{where}={v!r}: a bound width must be > 0 (null or .inf switches a channel off)")
-        return x
-
-    com_w = [value("task.com_width", c) for c in (com if isinstance(com, (list, tuple)) else [com] * 3)]
+    com_w = [_width("task.com_width", c) for c in (com if isinstance(com, (list, tuple)) else [com] * 3)]
     if len(com_w) != 3:
         raise JtError(f"task.com_width={com!r}: one width or three (x, y, z)")
-    w = np.array(com_w + [value("task.orientation_width", orientation)] * (1 + n_joint)
-                 + [value("task.end_effector_width", end_effector)] * 4)
-    groups = {"com": range(0, 3), "orientation": range(3, 4 + n_joint), "end_effector": range(4 + n_joint, len(names))}
-    for key, v in dict(per_channel or {}).items():
-        key = str(key)
-        if key in groups:
-            w[list(groups[key])] = value(f"task.widths.{key}", v)
-        elif key in names:
-            w[names.index(key)] = value(f"task.widths.{key}", v)
+    w = np.array(com_w + [_width("task.orientation_width", orientation)] * (1 + n_joint)
+                 + [_width("task.end_effector_width", end_effector)] * 4)
+    return _override(skeleton, w, per_channel or {}, "task.widths")
+
+
+def width_table(skeleton: Any, base: np.ndarray, rows: Any) -> np.ndarray:
+    """A phase table ``(K, n_channels)`` from ``rows``: each row ``{channel or group: width}``
+    overriding the constant widths ``base`` ``(n_channels,)`` at that row's phase (``None``/``inf``:
+    off), or a full list of ``n_channels`` widths. Row k lies at phase ``k / (K - 1)`` (one row:
+    constant). An empty ``rows`` gives a ``(0, n_channels)`` table (no table: ``base`` throughout).
+
+    Raises:
+        JtError: a row that is neither, a width <= 0, an unknown channel (one line).
+    """
+    from toolkit.errors import JtError
+
+    names = channel_names(skeleton)
+    out = []
+    for k, row in enumerate(list(rows or [])):
+        where = f"task.width_table[{k}]"
+        if isinstance(row, Mapping):
+            w = _override(skeleton, np.asarray(base, dtype=float).copy(), row, where)
+        elif isinstance(row, (list, tuple)) and len(row) == len(names):
+            w = np.array([_width(f"{where}[{i}]", v) for i, v in enumerate(row)])
         else:
-            raise JtError(f"task.widths.{key}: unknown bound channel; one of: {', '.join(GROUPS + names)}")
-    return w
+            raise JtError(f"{where}={row!r}: a row is {{channel or group: width}} or a list of "
+                          f"{len(names)} widths ({', '.join(names)})")
+        out.append(w)
+    return np.array(out, dtype=float).reshape(-1, len(names))
+
+
+def widths_at(table: np.ndarray, phase: float) -> np.ndarray:
+    """Widths ``(n_channels,)`` of a phase table ``(K, n_channels)`` at ``phase`` (taken mod 1):
+    linear interpolation between the two rows around it; an ``inf`` (off) row keeps the channel
+    off between it and its neighbours (a row's own phase gives that row exactly)."""
+    k = table.shape[0]
+    if k == 1:
+        return table[0].copy()
+    x = (float(phase) % 1.0) * (k - 1)
+    i = min(int(x), k - 2)
+    u = x - i
+    if u == 0.0:
+        return table[i].copy()
+    return (1.0 - u) * table[i] + u * table[i + 1]
 
 
 def violations(d: np.ndarray, w: np.ndarray, names: tuple[str, ...]) -> list[str]:

@@ -36,7 +36,7 @@ def episode(env: Any, phase: float, max_steps: int) -> dict[str, Optional[int]]:
     zero = np.zeros(env.action_space.shape, np.float32)
     for _ in range(max_steps):
         _, _, te, tr, _ = env.step(zero)
-        inside.append(not bd.violations(env.difference(), env.widths, env.names))
+        inside.append(not bd.violations(env.difference(), env.widths_at(env.ref.phase(env.clip_time)), env.names))
         if te or tr:
             break
     return tally(inside)

@@ -58,6 +58,7 @@ class SpacetimeSpec:
     ground_clearance: float = 0.0
     termination: str = "bounds"  # bounds | contact
     widths: list = dataclasses.field(default_factory=list)  # (n_channels,), inf = off; [] = 002 §5.1
+    width_table: list = dataclasses.field(default_factory=list)  # (K, n_channels) over phase [0, 1]; [] = widths
     time_limit: float = 20.0
     hold_s: float = 0.5
     init_phase: Optional[float] = None
@@ -87,12 +88,18 @@ class SpacetimeEnv(CharacterEnv):
         self.control_hz = self.sim_hz / self.substeps
         self.names = bd.channel_names(self.skeleton)
         self.widths = np.asarray(spec.widths, dtype=float) if len(spec.widths) else bd.widths(self.skeleton)
+        self.width_table = np.asarray(spec.width_table, dtype=float).reshape(-1, len(self.names))
         self.style_terms = [(str(t["name"]), plugins.load("reward", str(t["name"]))(
             {k: v for k, v in t.items() if k != "name"})) for t in spec.style]
         self.evaluating = False
         self._start(0.0 if spec.init_phase is None else float(spec.init_phase))
 
     # ------------------------------------------------------------------ episode bookkeeping
+    def widths_at(self, phase: float) -> np.ndarray:
+        """The bound widths ``(n_channels,)`` at clip ``phase``: the phase table's there, else the
+        constant ones."""
+        return bd.widths_at(self.width_table, phase) if len(self.width_table) else self.widths
+
     def _rule(self, allowed: tuple) -> tuple:
         forbidden = [i for i in range(-1, self.n_links) if i not in set(int(a) for a in allowed)]
         if not forbidden:
@@ -235,7 +242,7 @@ class SpacetimeEnv(CharacterEnv):
             reason = rec["reason"] if outcome else ""
         elif self.spec_.termination == "bounds":
             self.last_d = d = self.difference()
-            out = bd.violations(d, self.widths, self.names)
+            out = bd.violations(d, self.widths_at(self.ref.phase(self.clip_time)), self.names)
             if out:
                 terminated, reason = True, "out of bounds: " + ",".join(out)
             else:

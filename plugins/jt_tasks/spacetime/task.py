@@ -82,6 +82,8 @@ class SpacetimeConfig(PolicyConfig):
     """M, ankle and wrist channels (002 §5.1); null: off."""
     widths: dict = dataclasses.field(default_factory=dict)
     """{channel or group (com, orientation, end_effector): width} overrides; null or .inf switches a channel off (002 §5.3.1 style runs)."""
+    width_table: list = dataclasses.field(default_factory=list)
+    """Phase table: K rows evenly over phase [0, 1], each {channel or group: width} over the widths above (or 22 numbers), linearly interpolated at the clip's phase mod 1 (authors' code); []: the constant widths (002 §5.1; every table the authors ship is constant)."""
     time_limit: float = 20.0
     """S, training episodes are truncated (bootstrapped) here (002 §5.1)."""
     hold_s: float = 0.5
@@ -152,7 +154,8 @@ class SpacetimeConfig(PolicyConfig):
         require(self.termination in ("bounds", "contact"), "task.termination", self.termination,
                 "bounds (002 §3.2) or contact (the DeepMimic baseline)")
         com = list(self.com_width) if isinstance(self.com_width, (list, tuple)) else self.com_width
-        bd.widths(HUMANOID, com, self.orientation_width, self.end_effector_width, self.widths)
+        base = bd.widths(HUMANOID, com, self.orientation_width, self.end_effector_width, self.widths)
+        bd.width_table(HUMANOID, base, self.width_table)
         for key in ("time_limit", "hold_s", "eval_time_limit"):
             v = getattr(self, key)
             require(finite(v) and (v > 0 or (key == "hold_s" and v >= 0)), f"task.{key}", v, "must be a finite number > 0")
@@ -221,7 +224,8 @@ class SpacetimeTask(PolicyTask):
         allowed = allowed_links(HUMANOID, clip, None if p.allowed_contacts is None else list(p.allowed_contacts))
         return SpacetimeSpec(clip=str(p.clip), heading_axis=self.heading_axis(), loop=p.loop,
                              ground_clearance=float(p.ground_clearance), termination=p.termination,
-                             widths=[float(x) for x in w], time_limit=float(p.time_limit), hold_s=float(p.hold_s),
+                             widths=[float(x) for x in w],
+                             width_table=bd.width_table(HUMANOID, w, p.width_table).tolist(), time_limit=float(p.time_limit), hold_s=float(p.hold_s),
                              init_phase=p.init_phase, train_allowed=allowed, eval_allowed=allowed,
                              eval_time_limit=float(p.eval_time_limit), style=[dict(t) for t in p.style],
                              mix=None if p.mix is None else float(p.mix),

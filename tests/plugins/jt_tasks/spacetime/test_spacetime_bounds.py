@@ -135,3 +135,32 @@ def test_bad_widths_are_one_line_errors(kw, match):
     with pytest.raises(JtError, match=match) as e:
         bd.widths(HUMANOID, **kw)
     assert "\n" not in str(e.value)
+
+
+def test_phase_tables_interpolate_linearly_between_evenly_spaced_rows():
+    """K rows over phase [0, 1] (row k at k / (K - 1)), linear in between, taken at phase mod 1
+    (authors' code); an off (inf) row keeps its channel off up to its neighbours."""
+    base = bd.widths(HUMANOID)
+    t = bd.width_table(HUMANOID, base, [{"com": 0.1}, {"com": 0.3, "right_knee": None}, {"com_y": 0.5}])
+    assert t.shape == (3, 22)
+    cy, knee, neck = NAMES.index("com_y"), NAMES.index("right_knee"), NAMES.index("neck")
+    assert bd.widths_at(t, 0.0)[cy] == 0.1 and bd.widths_at(t, 0.5)[cy] == 0.3 and bd.widths_at(t, 0.999)[cy] > 0.49
+    assert bd.widths_at(t, 0.25)[cy] == pytest.approx(0.2) and bd.widths_at(t, 0.75)[cy] == pytest.approx(0.4)
+    assert bd.widths_at(t, 1.25)[cy] == pytest.approx(0.2)  # mod 1
+    assert bd.widths_at(t, 0.0)[knee] == 0.7 and np.isinf(bd.widths_at(t, 0.3)[knee]) and np.isinf(bd.widths_at(t, 0.7)[knee])
+    assert all(bd.widths_at(t, p)[neck] == 0.7 for p in np.linspace(0, 1, 11))  # rows override only what they name
+    one = bd.width_table(HUMANOID, base, [[0.25] * 22])
+    assert np.array_equal(bd.widths_at(one, 0.6), np.full(22, 0.25))
+    assert bd.width_table(HUMANOID, base, []).shape == (0, 22)
+
+
+@pytest.mark.parametrize("rows, match", [
+    ([{"knee": 0.5}], r"width_table\[0\]\.knee: unknown bound channel"),
+    ([{"com": 0.1}, {"com": 0.0}], r"width_table\[1\]\.com=0.0: a bound width must be > 0"),
+    ([[0.2, 0.2]], "a list of 22 widths"),
+    (["wide"], "a row is"),
+])
+def test_bad_phase_tables_are_one_line_errors(rows, match):
+    with pytest.raises(JtError, match=match) as e:
+        bd.width_table(HUMANOID, bd.widths(HUMANOID), rows)
+    assert "\n" not in str(e.value)

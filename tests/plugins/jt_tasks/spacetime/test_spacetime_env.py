@@ -140,3 +140,36 @@ def test_style_terms_multiply_into_the_survival_reward():
         assert all(0.0 <= r < 1.0 for r in rs) and len(set(rs)) > 1
     finally:
         e.close()
+
+
+def test_a_phase_table_bounds_each_phase_by_its_own_row():
+    """A table that is tight (CoM 1 mm) over phases 0-0.2 and loose (10 m) from 0.25 on: an
+    episode started in the loose part survives to its time limit, one started in the tight part
+    is out of bounds at once."""
+    import math
+
+    loose = [10.0] * 22
+    tight = dict(zip(("com_x", "com_y", "com_z"), (1e-3,) * 3))
+    from jt_tasks.spacetime import bounds as bd
+    from toolkit.motion.skeletons import HUMANOID
+
+    table = bd.width_table(HUMANOID, np.array(loose), [tight] * 5 + [{}] * 16).tolist()  # rows at k / 20
+    e = make_env(seed=0, widths=loose, width_table=table, time_limit=0.3)
+    try:
+        assert e.widths_at(0.1)[1] == 1e-3 and e.widths_at(0.5)[1] == 10.0
+        assert e.widths_at(0.225)[1] == pytest.approx(0.5 * (1e-3 + 10.0))
+
+        def steps_from(phase: float) -> tuple[int, str]:
+            e.reset(options={"phase": phase})
+            n, done, info = 0, False, {}
+            while not done:
+                _, _, te, tr, info = e.step(np.full(28, 0.3, np.float32))
+                n += 1
+                done = te or tr
+            return n, info.get("reason", "")
+
+        n_tight, why = steps_from(0.02)
+        n_off, why_off = steps_from(0.45)
+        assert why.startswith("out of bounds: com_") and n_tight < n_off and why_off == "time limit"
+    finally:
+        e.close()
