@@ -7,11 +7,14 @@ averages of the start targets, and eq 12's buffer sizes after each iteration, 00
 last iteration's as bars), ``com_bounds.png``, the Fig. 5 analogue: the final rollout's CoM
 height against the clip phase with the reference and its ``com_y`` bounds, and
 ``motion_vs_reference.gif``: the final rollout (left) beside the reference clip played
-kinematically at the same clip times (right), one frame per control step.
+kinematically at the same clip times (right), one frame per control step. ``style_measures``
+gives a motion's mean kinetic energy (002 eq 4's) and hull volume (eq 5's), the evaluation's and
+the reference's at the same clip times (``reference_bodies``), logged as ``style_*`` / ``ref_*``.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -120,6 +123,40 @@ def reference_frames(env: Any, times: np.ndarray, width: int, height: int) -> li
             ref = env.ref.sample(env.t0 + float(t))
             sim.reset(ref.q, ref.qd)
             out.append(np.asarray(sim.render(int(width), int(height), camera))[..., :3].astype(np.uint8))
+    finally:
+        sim.close()
+    return out
+
+
+def style_measures(bodies: list, masses: np.ndarray, hz: float) -> dict[str, float]:
+    """Mean style measures of a motion (002 §3.3) from its control steps ``bodies`` = ``[(link CoMs
+    (n_links + 1, 3), joint origins (n_links, 3)), ...]`` at ``hz``, as the style terms measure a
+    state: ``energy`` (J, eq 4's kinetic energy less the horizontal CoM part, link velocities by
+    differences over a step, from the second step on) and ``volume`` (m³, eq 5's convex hull of the
+    joint origins); NaN for an empty motion."""
+    from jt_rewards.style import hull_volume, kinetic_energy
+
+    if not bodies:
+        return {"energy": math.nan, "volume": math.nan}
+    vols = [hull_volume(j) for _, j in bodies]
+    links = [np.asarray(p, dtype=float) for p, _ in bodies]
+    ens = [kinetic_energy((b - a) * hz, masses) for a, b in zip(links[:-1], links[1:])]
+    return {"energy": float(np.mean(ens)) if ens else math.nan, "volume": float(np.mean(vols))}
+
+
+def reference_bodies(env: Any, times: np.ndarray) -> list:
+    """The reference of ``env`` (still open) posed at clip times ``env.t0 + times`` in a second
+    simulator (kinematically, as ``reference_frames``): ``[(link CoMs, joint origins), ...]`` for
+    ``style_measures``."""
+    from jt_tasks.policy.env import load_simulator
+
+    sim = load_simulator(env.spec_.sim)
+    out = []
+    try:
+        for t in np.asarray(times, dtype=float).reshape(-1):
+            ref = env.ref.sample(env.t0 + float(t))
+            sim.reset(ref.q, ref.qd)
+            out.append((sim.link_states()[0], sim.link_poses(range(env.n_links))[0]))
     finally:
         sim.close()
     return out

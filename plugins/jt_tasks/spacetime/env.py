@@ -109,6 +109,7 @@ class SpacetimeEnv(CharacterEnv):
     def _start(self, phase: float, evaluate: bool = False, state: Optional[np.ndarray] = None) -> None:
         spec = self.spec_
         self.evaluating = bool(evaluate)
+        self.eval_bodies: list[tuple[np.ndarray, np.ndarray]] = []  # (link CoMs, joint origins) per evaluation step
         self.phase0 = float(phase if state is None else min(max(float(state[0]), 0.0), 1.0))
         self.t0 = self.phase0 * self.ref.period
         ref = self.ref.sample(self.t0)
@@ -135,6 +136,12 @@ class SpacetimeEnv(CharacterEnv):
         self.last_d = np.zeros(len(self.names))
         self._links_now = self._links_prev = self.sim.link_states()[0] if self.style_terms else None
         self._vel_prev = self._qd_prev = None
+        if evaluate:
+            self._record_body()
+
+    def _record_body(self) -> None:
+        """Keep the evaluation's bodies (link CoMs, joint origins) now, for its style measures."""
+        self.eval_bodies.append((self.sim.link_states()[0], self.sim.link_poses(range(self.n_links))[0]))
 
     @property
     def t(self) -> float:
@@ -230,6 +237,8 @@ class SpacetimeEnv(CharacterEnv):
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
         self.steps += 1
+        if self.evaluating:  # the style measures of the evaluation (artifacts.style_measures)
+            self._record_body()
         if self.style_terms:
             self._links_prev, self._links_now = self._links_now, self.sim.link_states()[0]
         outcome, reason = rec["outcome"], ""

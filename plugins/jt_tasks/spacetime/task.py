@@ -256,8 +256,12 @@ class SpacetimeTask(PolicyTask):
     def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
         from jt_tasks.spacetime.artifacts import com_height_data
 
+        from jt_tasks.spacetime.artifacts import reference_bodies, style_measures
+
         info = ro["info"]
         ro["com_height"] = com_height_data(env, ro["time"], ro["com"])
+        ro["style"] = {"policy": style_measures(env.eval_bodies, env.masses, env.control_hz),  # 002 §3.3
+                       "reference": style_measures(reference_bodies(env, ro["time"]), env.masses, env.control_hz)}
         if ro["frames"]:  # the reference at the same clip times, for motion_vs_reference.gif
             from jt_tasks.spacetime.artifacts import reference_frames
 
@@ -267,7 +271,8 @@ class SpacetimeTask(PolicyTask):
         data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))},
                 "phase": ro["com_height"]["phase"]}
         attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
-                 "reason": str(info.get("reason", "")), "widths": str(list(spec.widths))}
+                 "reason": str(info.get("reason", "")), "widths": str(list(spec.widths)),
+                 **{f"{who}_{k}": v for who, m in ro["style"].items() for k, v in m.items()}}
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
@@ -287,6 +292,9 @@ class SpacetimeTask(PolicyTask):
             "samples": float(res.samples), "iterations": float(res.iterations),
             "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
         }
+        for who, m in ro.get("style", {}).items():  # style measures vs the reference's (002 §3.3, §5.3)
+            prefix = "style" if who == "policy" else "ref"
+            metrics.update({f"{prefix}_energy": m["energy"], f"{prefix}_volume": m["volume"]})
         metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
         history = {"mean_return": return_curve(trained),
                    "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}

@@ -68,3 +68,24 @@ def test_smoke_evaluation_writes_the_policy_beside_the_reference(tmp_path):
     assert np.abs(ref[0] - policy[0]).mean() < 1.0  # both start in the reference state at eval_phase
     steps = [np.abs(ref[i + 1] - ref[i]).mean() for i in range(n - 1)]
     assert min(steps) > 0.1  # the reference half changes every frame
+    # the style measures of the rollout and of the reference at the same clip times (002 §3.3)
+    m = ev.metrics
+    assert {"style_energy", "ref_energy", "style_volume", "ref_volume"} <= set(m)
+    assert 0.05 < m["ref_volume"] < 0.25 and 5.0 < m["ref_energy"] < 150.0  # the run clip (research notes: 0.155 m³, 64 J medians)
+    assert m["style_volume"] == pytest.approx(m["ref_volume"], rel=0.5)  # 1 s from the reference state
+
+
+def test_style_measures_of_a_translating_cube_are_half_m_v_squared_and_one():
+    """A rigid unit cube of joint origins moving up at 2 m/s (link CoMs with it): eq 4's energy is
+    ½ M v² (a vertical motion keeps it all), eq 5's volume 1; sideways the energy is 0."""
+    from jt_tasks.spacetime.artifacts import style_measures
+
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    links = np.array([[0.0, 0.5, 0.0], [0.3, 0.2, 0.1], [0.0, 0.9, 0.4]])
+    masses = np.array([1.0, 2.0, 3.0])
+    up = [(links + [0.0, 2.0 * k / 30.0, 0.0], cube) for k in range(5)]
+    side = [(links + [2.0 * k / 30.0, 0.0, 0.0], cube) for k in range(5)]
+    m = style_measures(up, masses, 30.0)
+    assert m["energy"] == pytest.approx(0.5 * 6.0 * 4.0) and m["volume"] == pytest.approx(1.0)
+    assert style_measures(side, masses, 30.0)["energy"] == pytest.approx(0.0, abs=1e-9)
+    assert np.isnan(style_measures([], masses, 30.0)["energy"])

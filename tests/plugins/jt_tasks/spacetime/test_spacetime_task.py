@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from toolkit.errors import JtError
@@ -75,3 +76,23 @@ def test_quick_and_paper_presets_compose_with_the_papers_batch():
     assert quick.agent.total_samples == 3 * 4096 and quick.task.filmstrip_frames > 0
     assert paper.agent.total_samples == 6000 * 4096 and list(paper.agent.policy_hidden) == [1024, 512]
     assert paper.agent.n_workers == 18 and paper.task.eval_time_limit == 20.0
+
+
+@pytest.mark.parametrize("preset, clip, term, mode, widths", [
+    ("style_walk_low_volume", "walk", "volume", "decrease", {"right_knee": 1.0, "neck": 0.7, "root": 0.7, "com_y": 0.2}),
+    ("style_run_high_energy", "run", "energy", "increase", {"left_hip": 1.0, "right_elbow": 1.0, "chest": 0.7}),
+    ("style_cartwheel_low_energy", "cartwheel", "energy", "decrease",
+     {"chest": np.inf, "right_knee": np.inf, "ee_left_wrist": np.inf, "root": 1.0, "neck": 1.0, "left_ankle": 1.0, "com_x": 0.2}),
+    ("style_dance_high_energy", "dance_a", "energy", "increase", {"left_shoulder": 1.0, "root": 0.7, "ee_right_ankle": 0.5}),
+])
+def test_style_presets_loosen_the_bounds_and_add_their_term(preset, clip, term, mode, widths):
+    """002 §5.3.1's style runs as presets: the clip, the style term and the loosened bounds."""
+    from jt_tasks.spacetime.bounds import channel_names
+    from toolkit.motion.skeletons import HUMANOID
+
+    t, cfg = task(f"preset={preset}")
+    assert cfg.task.clip == clip and [dict(s) for s in cfg.task.style] == [{"name": term, "mode": mode}]
+    spec = t.env_spec({})
+    names = channel_names(HUMANOID)
+    for channel, w in widths.items():
+        assert spec.widths[names.index(channel)] == w, channel
