@@ -79,9 +79,25 @@ def quat_multiply(a, b) -> np.ndarray:
 def quat_rotate(q, v) -> np.ndarray:
     """Rotate vectors ``v`` ``(..., 3)`` by unit quaternions ``q`` ``(..., 4)``."""
     q, v = _arr(q), _arr(v)
+    if q.shape == (4,):  # one rotation (the envs' per-step frames): the same operations, fewer calls
+        return _rotate_by_one(q, v)
     u, w = q[..., :3], q[..., 3:4]
     t = 2.0 * np.cross(u, v)
     return v + w * t + np.cross(u, t)
+
+
+def _rotate_by_one(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``quat_rotate`` of vectors ``v`` ``(..., 3)`` by one quaternion ``q`` ``(4,)``, bit for bit:
+    ``v + w t + u × t`` with ``t = 2 (u × v)``, each product and sum in ``np.cross``'s order, on
+    Python floats for one vector and on ``v``'s columns for many."""
+    x, y, z, w = q.tolist()
+    if v.shape == (3,):
+        vx, vy, vz = v.tolist()
+    else:
+        vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
+    out = (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx))
+    return np.array(out) if v.shape == (3,) else np.stack(out, axis=-1)
 
 
 def quat_relative(a, b) -> np.ndarray:

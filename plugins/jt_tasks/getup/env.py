@@ -94,6 +94,7 @@ class GetupEnv(CharacterEnv):
         self.curve_starts = np.array([c.start for c in self.curves])
         self.control_hz = float(self.sim.control_hz)
         self.dt = 1.0 / self.control_hz
+        self._m = self._lv = None  # this state's measurements and link velocities (cached per step)
         terms = dict((spec.reward or {}).get("terms") or {})
         self.terms = {str(k): plugins.load("reward", str(k))(v) for k, v in terms.items()}
         self.natural = set(spec.natural_terms)
@@ -146,7 +147,7 @@ class GetupEnv(CharacterEnv):
         self.log: list[dict[str, float]] = []
         self.last_action = np.zeros(self.action_space.shape, dtype=np.float64)
         self._prev_links = None
-        self._m = None
+        self._m = self._lv = None
         self.supine = bool(self.measure()["features"][2] < math.pi / 2)
         self.head_down_at_start = self._head_contact() or self._head_height() < 0.15
 
@@ -198,7 +199,7 @@ class GetupEnv(CharacterEnv):
             if curve is None:
                 st = spec.fallen[fallen]
                 self.sim.reset(np.asarray(st["q"], float), np.asarray(st["qd"], float))
-                self._m = None
+                self._m = self._lv = None
                 angles = self._measure_now()["features"]
                 curve = pick_curve(angles, self.curve_starts, rng, spec.curve_match_deg)
         if curve is None:
@@ -226,14 +227,18 @@ class GetupEnv(CharacterEnv):
 
     def link_velocities(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Link positions, orientations, angular and linear velocities ``(15, ·)`` (world), the
-        velocities by finite differences over the last control step."""
-        pos, orn = self.sim.link_states()
-        if self._prev_links is None:
-            return pos, orn, np.zeros_like(pos), np.zeros_like(pos)
-        p0, o0 = self._prev_links
-        v = (pos - p0) / self.dt
-        w = rot.quat_to_expmap(rot.quat_multiply(orn, rot.quat_conjugate(o0))) / self.dt
-        return pos, orn, w, v
+        velocities by finite differences over the last control step (cached until the next step:
+        the reward's record and the observation both read them)."""
+        if self._lv is None:
+            pos, orn = self.sim.link_states()
+            if self._prev_links is None:
+                self._lv = pos, orn, np.zeros_like(pos), np.zeros_like(pos)
+            else:
+                p0, o0 = self._prev_links
+                v = (pos - p0) / self.dt
+                w = rot.quat_to_expmap(rot.quat_multiply(orn, rot.quat_conjugate(o0))) / self.dt
+                self._lv = pos, orn, w, v
+        return tuple(a.copy() for a in self._lv)
 
     def targets(self, t: Any) -> np.ndarray:
         """Curve targets ``(…, 3)`` at episode time(s) ``t``."""
@@ -244,6 +249,7 @@ class GetupEnv(CharacterEnv):
         if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
             self.action_space_.set_condition(self.targets(self.t))
         self._prev_links = self.sim.link_states()
+        self._lv = None
         self.last_action = np.asarray(action, dtype=np.float64).copy()
         return super().pd_targets(action)
 
@@ -273,7 +279,7 @@ class GetupEnv(CharacterEnv):
                 "naturalness": float(min(max(self.penalty, 0.0), 1.0))}
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
-        self._m = None
+        self._m = self._lv = None
         spec = self.spec_
         if rec["failed"]:
             return 0.0, True, False, self._final(f"simulator: {rec['reason']}", False)

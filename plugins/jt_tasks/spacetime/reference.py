@@ -75,7 +75,11 @@ def heading_quat(q_root: np.ndarray, axis: str = "x") -> np.ndarray:
     a = HEADING_AXES[axis]
     f = rot.quat_rotate(np.asarray(q_root, dtype=float), a)
     yaw = math.atan2(-f[2], f[0]) - math.atan2(-a[2], a[0])
-    return rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), yaw)
+    # quat_from_axis_angle((0, 1, 0), yaw) bit for bit (numpy's sin / cos on the same one-element
+    # array, the unit axis's products kept, signed zeros included), without its general-case calls
+    half = 0.5 * np.array([yaw])
+    sn, cs = float(np.sin(half)[0]), float(np.cos(half)[0])
+    return np.array([0.0 * sn, 1.0 * sn, 0.0 * sn, cs])
 
 
 def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x") -> np.ndarray:

@@ -179,3 +179,19 @@ def test_one_quaternion_to_matrix_is_the_vectorised_result_bit_for_bit():
             assert np.array_equal(rot.quat_to_matrix(q), m)
     assert np.array_equal(rot.quat_to_matrix(np.zeros(4)), np.eye(3))
     assert rot.quat_to_matrix([0.0, 0.0, 0.0, 1.0]).shape == (3, 3)
+
+
+def test_rotating_by_one_quaternion_is_the_vectorised_result_bit_for_bit():
+    """``quat_rotate`` with one ``(4,)`` quaternion (the envs' heading frames) takes a shorter path;
+    its result, signed zeros included, is the batched path's for one vector and for many."""
+    rng = np.random.default_rng(1)
+    for scale in (1e-6, 1.0, 1e3):
+        for shape in [(3,), (7, 3), (2, 5, 3)]:
+            for _ in range(200):
+                q = rot.quat_normalize(rng.standard_normal(4))
+                v = rng.standard_normal(shape) * scale
+                fast = rot.quat_rotate(q, v)
+                batched = rot.quat_rotate(q[None], v[None] if v.ndim == 1 else v)
+                batched = batched[0] if v.ndim == 1 else batched
+                assert fast.shape == v.shape
+                assert np.array_equal(fast, batched) and np.array_equal(np.signbit(fast), np.signbit(batched))

@@ -91,3 +91,23 @@ def test_bad_clips_are_one_line_errors(clip, match, tmp_path):
     assert "\n" not in str(e.value)
     with pytest.raises(JtError, match="heading_axis"):
         SpacetimeReference("run", heading_axis="y")
+
+
+def test_heading_quat_is_the_general_yaw_quaternion_bit_for_bit():
+    """``heading_quat`` builds the yaw rotation without ``quat_from_axis_angle``'s general case:
+    the same quaternion, signed zeros included, for both heading axes."""
+    import math
+
+    from jt_tasks.spacetime.reference import HEADING_AXES, heading_quat
+    from toolkit.motion import rotations as rot
+
+    rng = np.random.default_rng(4)
+    for _ in range(500):
+        q = rot.quat_normalize(rng.standard_normal(4))
+        for axis in ("x", "z"):
+            a = HEADING_AXES[axis]
+            f = rot.quat_rotate(q[None], a)[0]
+            yaw = math.atan2(-f[2], f[0]) - math.atan2(-a[2], a[0])
+            expect = rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), yaw)
+            got = heading_quat(q, axis)
+            assert np.array_equal(got, expect) and np.array_equal(np.signbit(got), np.signbit(expect))
