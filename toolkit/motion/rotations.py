@@ -40,6 +40,10 @@ def quat_identity(shape: tuple[int, ...] = ()) -> np.ndarray:
 def quat_normalize(q) -> np.ndarray:
     """Unit quaternions ``(..., 4)``; a zero quaternion becomes the identity."""
     q = _arr(q)
+    if q.shape == (4,):  # one quaternion: Python floats, the same bits (see _quat_to_matrix_one)
+        x, y, z, w = q.tolist()
+        n = math.sqrt(x * x + y * y + z * z + w * w)
+        return np.array([x / n, y / n, z / n, w / n] if n > _EPS else [0.0, 0.0, 0.0, 1.0])
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     out = q / np.maximum(n, _EPS)
     return np.where(n > _EPS, out, quat_identity(q.shape[:-1]))
@@ -48,6 +52,8 @@ def quat_normalize(q) -> np.ndarray:
 def quat_canonical(q) -> np.ndarray:
     """The same rotations with ``w >= 0`` ``(..., 4)`` (the double-cover representative)."""
     q = _arr(q)
+    if q.shape == (4,):
+        return -q if q[3] < 0.0 else q.copy()
     return np.where(q[..., 3:4] < 0.0, -q, q)
 
 
@@ -62,7 +68,13 @@ quat_inverse = quat_conjugate
 
 def quat_multiply(a, b) -> np.ndarray:
     """Hamilton product ``a * b`` ``(..., 4)``: rotate by ``b`` first, then by ``a``."""
-    a, b = np.broadcast_arrays(_arr(a), _arr(b))
+    a, b = _arr(a), _arr(b)
+    if a.shape == b.shape == (4,):  # two quaternions: Python floats, the same sums in the same order
+        ax, ay, az, aw = a.tolist()
+        bx, by, bz, bw = b.tolist()
+        return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                         aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
+    a, b = np.broadcast_arrays(a, b)
     ax, ay, az, aw = np.moveaxis(a, -1, 0)
     bx, by, bz, bw = np.moveaxis(b, -1, 0)
     return np.stack(

@@ -195,3 +195,20 @@ def test_rotating_by_one_quaternion_is_the_vectorised_result_bit_for_bit():
                 batched = batched[0] if v.ndim == 1 else batched
                 assert fast.shape == v.shape
                 assert np.array_equal(fast, batched) and np.array_equal(np.signbit(fast), np.signbit(batched))
+
+
+def test_one_quaternion_normalize_canonical_multiply_are_the_vectorised_results():
+    """The ``(4,)`` paths of ``quat_normalize``, ``quat_canonical`` and ``quat_multiply`` (every
+    episode's end goes through them) give the batched results bit for bit, signed zeros, zero and
+    NaN quaternions included."""
+    rng = np.random.default_rng(9)
+
+    def same(x, y):
+        return x.shape == y.shape and np.array_equal(x, y, equal_nan=True) and np.array_equal(np.signbit(x), np.signbit(y))
+
+    cases = [rng.standard_normal(4) * s for s in (1e-13, 1e-6, 1.0, 1e3) for _ in range(500)]
+    cases += [np.zeros(4), np.array([0.0, 0.0, 0.0, -0.0]), np.array([np.nan, 0.0, 0.0, 1.0]), np.array([0.0, -1.0, 0.0, -0.5])]
+    for a, b in zip(cases, cases[1:] + cases[:1]):
+        assert same(rot.quat_normalize(a), rot.quat_normalize(a[None])[0])
+        assert same(rot.quat_canonical(a), rot.quat_canonical(a[None])[0])
+        assert same(rot.quat_multiply(a, b), rot.quat_multiply(a[None], b)[0])
