@@ -216,6 +216,7 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
         "runs": {r["variant"].replace("/", "_"): np.array(r["runs"], dtype="S") for r in rows},
     }, attrs={"format": "jt.compare/1", "vary": label})
     _plot(rows, keys, wd / "compare.png", label)
+    curves = _plot_curves(_curves(store, per_cell, keys), wd / "compare_curves.png", label)
     store.log_artifacts(run_id, wd)
     store.set_tags(run_id, {"jt.compare.runs": ",".join(rid for _, rid, _ in per_cell)[:5000]})
     labels: dict[str, str] = {}
@@ -237,7 +238,9 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
                          ", ".join(names.get(x) or x for x in r["runs"])] for r in rows]), "",
         f"Reproduce: `{command}`", "",
         "Metrics: `<variant>/<metric>_mean` and `_std`; the bar chart is the artifact `compare.png`, "
-        "the numbers `compare.h5`; the compared runs are this run's children."])
+        "the numbers `compare.h5`; the compared runs are this run's children."
+        + (f" `compare_curves.png`: {', '.join(curves)} against samples, mean over seeds (thick) and each seed."
+           if curves else "")])
     store.set_tags(run_id, {describe.NOTE: describe.fit(note + "\n")})
     return CompareResult(table, run_id, store.root, rows)
 
@@ -269,3 +272,48 @@ def _plot(rows: list[dict[str, Any]], keys: list[str], path: Path, title: str) -
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def _curves(store: Any, per_cell: list[tuple[str, str, dict[str, float]]],
+            keys: list[str]) -> dict[str, dict[str, list[np.ndarray]]]:
+    """``{metric: {variant: [(n_points, 2) step/value per run]}}`` of each key metric a run logged
+    as a curve (``train/<metric>``, at least two points: e.g. ``survival_s`` against samples)."""
+    from toolkit.execution.runner import curve_key
+
+    out: dict[str, dict[str, list[np.ndarray]]] = {}
+    for name, rid, _ in per_cell:
+        for k in keys:
+            pts = sorted((int(m.step), float(m.value)) for m in store.client.get_metric_history(rid, curve_key(k)))
+            if len(pts) > 1:
+                out.setdefault(k, {}).setdefault(name, []).append(np.array(pts, dtype=float))
+    return out
+
+
+def _plot_curves(curves: dict[str, dict[str, list[np.ndarray]]], path: Path, title: str) -> list[str]:
+    """``compare_curves.png``: per metric, each variant's runs (thin) and their mean at the steps
+    they share (thick) against the step (samples); the metrics drawn (none: no file)."""
+    if not curves:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(curves), figsize=(4.2 * len(curves) + 1, 3.4), squeeze=False)
+    for ax, (k, by_variant) in zip(axes[0], curves.items()):
+        for i, (variant, runs) in enumerate(by_variant.items()):
+            color = f"C{i % 10}"
+            for r in runs:
+                ax.plot(r[:, 0], r[:, 1], color=color, lw=0.7, alpha=0.5)
+            steps = sorted(set.intersection(*(set(r[:, 0]) for r in runs)))
+            if steps:
+                mean = [np.mean([r[r[:, 0] == x, 1][0] for r in runs]) for x in steps]
+                ax.plot(steps, mean, color=color, lw=2.0, label=f"{variant} (n={len(runs)})")
+        ax.set_xlabel("samples")
+        ax.set_title(k, fontsize=9)
+        ax.legend(fontsize=7, loc="best")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return list(curves)

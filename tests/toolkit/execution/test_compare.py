@@ -115,3 +115,25 @@ def test_hydra_prefixed_overrides_are_params_mlflow_takes(example_plugin, store_
                   ["task.centre=0.0,0.5"], seeds=1)
     run = Store(store_dir).get_run(res.run_id)
     assert run.info.status == "FINISHED" and run.data.params["base.curriculum"] == "~"
+
+
+def test_curves_of_the_compared_runs_are_drawn_per_variant(example_plugin, store_dir):
+    """Key metrics the runs logged as curves (the example task's ``train/curve``, 5 points each)
+    get ``compare_curves.png``: each variant's runs and their mean at the shared steps."""
+    from toolkit.execution.compare import _curves, _plot_curves
+    from toolkit.store.tracking import Store
+
+    res = compare(["task=quadratic", "executor.workers=1", f"store={store_dir}"], ["task.centre=0.0,0.5"], seeds=2)
+    store = Store(store_dir)
+    kids = store.get_run(res.run_id).data.tags["jt.compare.runs"].split(",")
+    per_cell = [(r["variant"], rid, {}) for r in res.rows for rid in r["runs"]]
+    curves = _curves(store, per_cell, ["train/curve", "value"])
+    assert list(curves) == ["train/curve"]  # value is one number per run, not a curve
+    assert {v: len(runs) for v, runs in curves["train/curve"].items()} == {"task.centre=0.0": 2, "task.centre=0.5": 2}
+    assert all(r.shape == (5, 2) and list(r[:, 0]) == [0, 1, 2, 3, 4] for runs in curves["train/curve"].values() for r in runs)
+    assert len(kids) == 4
+    png = store_dir / "curves.png"
+    assert _plot_curves(curves, png, "centre") == ["train/curve"] and png.stat().st_size > 5000
+    assert _plot_curves({}, store_dir / "none.png", "") == [] and not (store_dir / "none.png").exists()
+    # the quadratic task's key metric (value) has no curve: its comparison draws none
+    assert not (store.artifact_dir(res.run_id) / "compare_curves.png").exists()
