@@ -135,6 +135,7 @@ def bench_rollout(
     collect_steps: int = typer.Option(64, "--collect-steps", help="Collection steps per env (16 envs per worker)."),
     workers: str = typer.Option("1,2", "--workers", help="Worker counts of the collection measurement."),
     loops: str = typer.Option("auto", "--loops", help="Comma list of substep loops (sim.loop): auto, compiled, python."),
+    repeats: int = typer.Option(3, "--repeats", help="Env measurements per rate (fresh env each); the median is shown."),
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
 ) -> None:
     """Where a policy env's time goes per 600 Hz substep, and PPO collection samples/s per worker."""
@@ -153,6 +154,8 @@ def bench_rollout(
         raise JtError(f"--rates and --workers take comma lists of numbers, got {rates!r}, {workers!r}") from None
     if not rate_list or any(r <= 0 for r in rate_list) or not worker_list or any(w < 1 for w in worker_list):
         raise JtError("--rates must be positive rates and --workers counts >= 1")
+    if repeats < 1 or steps < 1:
+        raise JtError(f"--repeats and --steps must be >= 1, got {repeats} and {steps}")
     loop_list = [x.strip() for x in loops.split(",") if x.strip()]
     bad = [x for x in loop_list if x not in ("auto", "compiled", "python")]
     if bad or not loop_list:
@@ -162,7 +165,7 @@ def bench_rollout(
         for loop in loop_list:
             typer.echo(f"{t}, sim.loop={loop}: measuring ...")
             res = run_bench(t, ["action=raw", f"spd={spd}", f"sim.loop={loop}"], rate_list, steps,
-                            collect_steps, worker_list, echo=typer.echo)
+                            collect_steps, worker_list, echo=typer.echo, repeats=repeats)
             typer.echo(format_table(res))
             out["results"].append(res)
     if json_out:

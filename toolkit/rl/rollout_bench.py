@@ -119,9 +119,25 @@ def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: in
             "samples_per_s_per_worker": total / wall / n_workers, "peak_rss_mb": float(max(rss))}
 
 
+def median_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps: int = 400,
+                     repeats: int = 3) -> dict[str, float]:
+    """``env_breakdown`` ``repeats`` times, each on a fresh env: the median of every figure, and
+    ``physics_shares`` ``[...]`` of the runs (a 2-core machine's speed drifts between runs; one
+    run's share can be a few points off)."""
+    rows = [env_breakdown(make_env, control_hz, control_steps) for _ in range(max(1, int(repeats)))]
+    rows = [r for r in rows if r]
+    if not rows:
+        return {}
+    out = {k: float(np.median([r[k] for r in rows])) for k in rows[0]}
+    out["physics_shares"] = [float(r["physics_share"]) for r in rows]
+    return out
+
+
 def run_bench(task: str, overrides: list[str], rates: list[float], control_steps: int = 400,
-              n_steps: int = 64, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None) -> dict:
-    """The whole benchmark for one task (see the module docstring); ``echo`` prints progress."""
+              n_steps: int = 64, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None,
+              repeats: int = 3) -> dict:
+    """The whole benchmark for one task (see the module docstring); the env measurement is the
+    median of ``repeats`` runs; ``echo`` prints progress."""
     from toolkit import plugins
     from toolkit.config import compose
 
@@ -130,7 +146,7 @@ def run_bench(task: str, overrides: list[str], rates: list[float], control_steps
     t = plugins.load("task", task)(cfg)
     result: dict[str, Any] = {"task": task, "overrides": overrides, "env": [], "collection": []}
     for hz in rates:
-        row = env_breakdown(lambda: t.make_env(seed=0), hz, control_steps)
+        row = median_breakdown(lambda: t.make_env(seed=0), hz, control_steps, repeats)
         if row:
             result["env"].append(row)
             say(f"  env at {hz:g} Hz: {row['control_steps_per_s']:.0f} control steps/s, physics share "
@@ -179,7 +195,9 @@ def format_table(res: dict) -> str:
     for r in res["env"]:
         lines.append(f"{r['control_hz']:>6.0f}Hz {r['control_steps_per_s']:>8.0f} {r['us_physics']:>8.1f} "
                      f"{r['us_spd']:>6.1f} {r['us_io']:>6.1f} {r['us_checks']:>7.1f} {r['us_env']:>6.1f} "
-                     f"{r['us_total']:>7.1f}  {100 * r['physics_share']:>5.0f} %")
+                     f"{r['us_total']:>7.1f}  {100 * r['physics_share']:>5.0f} %"
+                     + (f" (median of {', '.join(f'{100 * x:.0f}' for x in r['physics_shares'])})"
+                        if len(r.get("physics_shares", [])) > 1 else ""))
     for r in res["collection"]:
         lines.append(f"PPO collection (1024-512 nets, 16 envs/worker), {int(r['n_workers'])} worker(s): "
                      f"{r['samples_per_s']:.0f} samples/s ({r['samples_per_s_per_worker']:.0f} per worker), "
