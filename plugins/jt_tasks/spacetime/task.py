@@ -189,7 +189,7 @@ class SpacetimeConfig(PolicyConfig):
 class SpacetimeTask(PolicyTask):
     """Spacetime bounds (002): PPO inside bounds around a clip, evaluated as 002 Table 1."""
 
-    key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "train_mean_length")
+    key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "samples", "train_mean_length")
     Config: ClassVar[type] = SpacetimeConfig
     env_path: ClassVar[str] = "jt_tasks.spacetime.env:SpacetimeEnv"
 
