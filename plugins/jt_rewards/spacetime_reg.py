@@ -8,7 +8,7 @@ env; research notes), the mean of four group means::
 
     r_reg = exp(−mean(E / β_E, |a_com,y| / β_com, mean_b |a_b − a_com| / β_b, mean_j |α_j| / β_j))
 
-* ``E`` the kinetic energy (``jt_rewards.style.kinetic_energy``: bodies' translational energy less
+* ``E`` the kinetic energy (``toolkit.motion.style.kinetic_energy``: bodies' translational energy less
   the horizontal CoM part, as eq 4), ``a_com,y`` the vertical CoM acceleration, ``a_b`` each
   body's CoM acceleration (base and links), ``α_j`` each internal joint's angular acceleration
   (norm over its dofs; the fixed wrists have none). Accelerations by differences of the control
@@ -33,7 +33,7 @@ from typing import Any, Optional
 import numpy as np
 
 from jt_rewards.base import RecordTerm
-from jt_rewards.style import kinetic_energy
+from toolkit.motion.style import kinetic_energy
 
 
 def upper_bound(x: np.ndarray) -> np.ndarray:

@@ -19,30 +19,10 @@ import dataclasses
 import math
 from typing import Any
 
-import numpy as np
-
 from jt_rewards.base import RecordTerm
+from toolkit.motion.style import hull_volume, kinetic_energy  # noqa: F401 - the terms' measures
 
 MODES = ("decrease", "increase")
-
-
-def kinetic_energy(link_vel: np.ndarray, masses: np.ndarray, rotational: float = 0.0) -> float:
-    """``Σ ½ m |v|² + rotational − ½ |P_xz|² / M`` (J), y-up world."""
-    v = np.asarray(link_vel, dtype=float).reshape(-1, 3)
-    m = np.asarray(masses, dtype=float).reshape(-1)
-    p = m @ v
-    return float(0.5 * np.sum(m * np.sum(v * v, axis=1)) + rotational - 0.5 * (p[0] ** 2 + p[2] ** 2) / m.sum())
-
-
-def hull_volume(points: np.ndarray) -> float:
-    """Volume (m³) of the convex hull of ``points`` ``(n, 3)``; 0 when they span no volume."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    pts = np.asarray(points, dtype=float).reshape(-1, 3)
-    try:
-        return float(ConvexHull(pts).volume)
-    except (QhullError, ValueError):
-        return 0.0
 
 
 def _mode(term: RecordTerm) -> None:

@@ -134,7 +134,7 @@ def style_measures(bodies: list, masses: np.ndarray, hz: float) -> dict[str, flo
     state: ``energy`` (J, eq 4's kinetic energy less the horizontal CoM part, link velocities by
     differences over a step, from the second step on) and ``volume`` (m³, eq 5's convex hull of the
     joint origins); NaN for an empty motion."""
-    from jt_rewards.style import hull_volume, kinetic_energy
+    from toolkit.motion.style import hull_volume, kinetic_energy
 
     if not bodies:
         return {"energy": math.nan, "volume": math.nan}
