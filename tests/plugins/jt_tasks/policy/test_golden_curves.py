@@ -12,6 +12,14 @@ simulator's substep loop) instead of PyBullet's cached link frames, which lag on
 behind; the crossing is found one substep earlier, moving the feature by ~0.005 rad. Everything
 else — every PPO statistic, the trajectory — is unchanged to the last digit.
 
+Machines: the last digits of a training curve depend on the CPU (numpy's and torch's SIMD kernels),
+and learning amplifies them (on an AMD EPYC the original recording's runup curve differs by up
+to 5 % in ``clip_frac``, from the same code). So a machine has its own recording,
+``<task>_smoke.<machine key>.json`` (``machine_key``: CPU model and SIMD features, numpy and
+torch versions), made from the commit before a change with ``JT_RECORD_GOLDEN=1``, and is held to
+it strictly (1e-9). A machine without one is held to the original recording loosely (10 %, 1e-3
+absolute): the same behaviour, not the same bits.
+
 A second, in session 5: the high jump's wall and mat are centred where the take-off velocity
 crosses the bar plane (docs/highjump.md), which moves the scene and the along-the-bar coordinate
 of the observation, so ``highjump_smoke.json`` was re-recorded on that change (its
@@ -21,6 +29,7 @@ of the observation, so ``highjump_smoke.json`` was re-recorded on that change (i
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +56,25 @@ def _tree(path: Path, group: str = "") -> dict:
     return out
 
 
+def machine_key() -> str:
+    """A short hash of what a curve's last digits depend on: CPU model, numpy's enabled SIMD
+    features, torch's CPU capability, numpy's and torch's versions."""
+    import hashlib
+    import platform
+
+    import torch
+
+    cpu = platform.processor()
+    if Path("/proc/cpuinfo").exists():
+        cpu = next((ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
+                    if ln.startswith("model name")), cpu)
+    core = getattr(np, "_core", None) or np.core
+    feats = sorted(k for k, v in core._multiarray_umath.__cpu_features__.items() if v)
+    text = "|".join([platform.machine(), cpu, str(torch.backends.cpu.get_cpu_capability()), np.__version__,
+                     torch.__version__, ",".join(feats)])
+    return hashlib.sha1(text.encode()).hexdigest()[:10]
+
+
 @pytest.mark.parametrize("task", ["highjump", "runup"])
 def test_same_seed_curve_equals_the_recording_before_the_layer(task, tmp_path):
     from toolkit.config import compose
@@ -59,14 +87,22 @@ def test_same_seed_curve_equals_the_recording_before_the_layer(task, tmp_path):
         kids = res.store.client.search_runs([res.store.client.get_run(res.run_id).info.experiment_id],
                                             filter_string=f"tags.mlflow.parentRunId = '{res.run_id}'")
         art = res.store.artifact_dir(kids[0].info.run_id)
-    golden = json.loads((GOLDEN / f"{task}_smoke.json").read_text())
-    hist = _tree(art / "ppo.h5", "history")
+    original = json.loads((GOLDEN / f"{task}_smoke.json").read_text())
+    hist, ro = _tree(art / "ppo.h5", "history"), _tree(art / "rollout.h5")
+    own = GOLDEN / f"{task}_smoke.{machine_key()}.json"
+    if os.environ.get("JT_RECORD_GOLDEN"):  # run on the commit before a change, on a new machine
+        own.write_text(json.dumps({
+            "recorded_with": "JT_RECORD_GOLDEN=1 on the machine this key names; see the module docstring",
+            "history": {k: hist[k].tolist() for k in original["history"]},
+            "rollout": {k: ro[k].tolist() for k in original["rollout"]}}, indent=1) + "\n")
+    strict = own.exists()
+    golden = json.loads(own.read_text()) if strict else original
+    rtol, atol = (1e-9, 1e-12) if strict else (0.1, 1e-3)
     for key, values in golden["history"].items():
-        np.testing.assert_allclose(hist[key], values, rtol=1e-9, atol=1e-12, err_msg=key)
-    ro = _tree(art / "rollout.h5")
+        np.testing.assert_allclose(hist[key], values, rtol=rtol, atol=atol, err_msg=f"{key} (strict: {strict})")
     for key, values in golden["rollout"].items():
-        if key.startswith("feature_"):  # the crossing is taken one substep earlier (see above)
+        if key.startswith("feature_") and not strict:  # the crossing is taken one substep earlier (see above)
             np.testing.assert_allclose(ro[key], values, atol=0.01, err_msg=key)
             continue
-        np.testing.assert_allclose(ro[key], values, rtol=1e-9, atol=1e-12, err_msg=key)
+        np.testing.assert_allclose(ro[key], values, rtol=rtol, atol=atol, err_msg=f"{key} (strict: {strict})")
     assert len(golden["history"]["policy_loss"]) == 4  # four PPO iterations were compared
