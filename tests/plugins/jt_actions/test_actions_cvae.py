@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from filter_contract import FilterOption
 from toolkit.testing.action import ActionSpaceContract
 from jt_actions.cvae import CVAEActionSpace
 from toolkit.errors import JtError
@@ -12,7 +13,7 @@ from toolkit.priors.limits import limit_targets
 STANDING = np.array([1.3, np.pi / 2, np.pi / 2])
 
 
-class TestCVAE(ActionSpaceContract):
+class TestCVAE(ActionSpaceContract, FilterOption):
     @pytest.fixture(autouse=True)
     def _priors(self, action_priors):
         self.priors = action_priors

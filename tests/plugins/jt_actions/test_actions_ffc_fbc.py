@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from filter_contract import FilterOption
 from toolkit.testing.action import ActionSpaceContract
 from jt_actions.ffc_fbc import FFCFBCActionSpace, unwrap_expmaps
 from toolkit.errors import JtError
@@ -19,7 +20,7 @@ def _angles(space, dofs_a, dofs_b):
     return np.array(out)
 
 
-class TestFFCFBC(ActionSpaceContract):
+class TestFFCFBC(ActionSpaceContract, FilterOption):
     def make(self):
         return FFCFBCActionSpace({"name": "ffc_fbc", "clip": "walk"})
 

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from filter_contract import FilterOption
 from toolkit.testing.action import ActionSpaceContract
 from jt_actions.base import naturalness
 from jt_actions.pvae import PVAEActionSpace
@@ -11,7 +12,7 @@ from toolkit.motion import HUMANOID
 from toolkit.priors.io import load_prior
 
 
-class TestPVAE(ActionSpaceContract):
+class TestPVAE(ActionSpaceContract, FilterOption):
     @pytest.fixture(autouse=True)
     def _priors(self, action_priors):
         self.priors = action_priors

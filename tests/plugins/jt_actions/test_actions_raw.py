@@ -2,13 +2,14 @@
 
 import numpy as np
 
+from filter_contract import FilterOption
 from toolkit.testing.action import ActionSpaceContract
 from jt_actions.raw import RawActionSpace
 from toolkit.motion import HUMANOID
 from toolkit.priors.limits import joint_limits
 
 
-class TestRaw(ActionSpaceContract):
+class TestRaw(ActionSpaceContract, FilterOption):
     def make(self):
         return RawActionSpace({"name": "raw"}, HUMANOID)
 
@@ -27,7 +28,7 @@ class TestRaw(ActionSpaceContract):
         assert space.penalty() == 1.0
 
 
-class TestRawAroundStart(ActionSpaceContract):
+class TestRawAroundStart(ActionSpaceContract, FilterOption):
     """``around_start``: the action is an offset from the episode's initial pose."""
 
     def make(self):
