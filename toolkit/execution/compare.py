@@ -150,6 +150,27 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
         raise
 
 
+def differing_params(params: Sequence[dict[str, str]]) -> list[str]:
+    """The params that tell runs apart: those whose *set* values (``None`` or absent: the run's
+    group has no such key) differ, seed and store excepted. When a group's ``name`` differs, its
+    other keys count only where set values differ (``action=raw`` has no ``beta``: ``action.beta``
+    tells ``cvae`` runs apart, not ``raw`` from ``cvae``)."""
+    ignore = {"seed", "store", "resume", "run_name"}
+    out = []
+    for k in sorted(set().union(*params)):
+        values = {p.get(k) for p in params if p.get(k) not in (None, "None")}
+        if k not in ignore and (len(values) > 1 or (k.endswith(".name") and len({p.get(k) for p in params}) > 1)):
+            out.append(k)
+    return sorted(out, key=lambda k: (k.rsplit(".", 1)[0], not k.endswith(".name"), k))  # a group's name first
+
+
+def variant_label(p: dict[str, str], differing: Sequence[str]) -> str:
+    """``action=cvae, action.beta=1.0``: a run's differing params it has (``group.name`` as ``group``)."""
+    parts = [f"{k[:-len('.name')] if k.endswith('.name') else k}={p.get(k)}" for k in differing
+             if p.get(k) not in (None, "None")]
+    return ", ".join(parts) or "all"
+
+
 def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareResult:
     """Compare finished runs: variants are the params that differ between them (seed excepted)."""
     from toolkit import plugins
@@ -165,14 +186,9 @@ def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareRes
         raise JtError("--runs needs at least two run ids")
     store = Store(store_root(store_path))
     runs = [store.get_run(r) for r in run_ids]
-    ignore = {"seed", "store", "resume", "run_name"}
     params = [r.data.params for r in runs]
-    differing = sorted(k for k in set().union(*params) if k not in ignore
-                       and len({p.get(k) for p in params}) > 1)
-    per_cell = []
-    for r, p in zip(runs, params):
-        label = ", ".join(f"{k}={p.get(k)}" for k in differing) or "all"
-        per_cell.append((label, r.info.run_id, dict(r.data.metrics)))
+    differing = differing_params(params)
+    per_cell = [(variant_label(p, differing), r.info.run_id, dict(r.data.metrics)) for r, p in zip(runs, params)]
     task_name = params[0].get("task.name", "")
     keys: list[str] = []
     if task_name in plugins.names("task"):

@@ -137,3 +137,18 @@ def test_curves_of_the_compared_runs_are_drawn_per_variant(example_plugin, store
     assert _plot_curves({}, store_dir / "none.png", "") == [] and not (store_dir / "none.png").exists()
     # the quadratic task's key metric (value) has no curve: its comparison draws none
     assert not (store.artifact_dir(res.run_id) / "compare_curves.png").exists()
+
+
+def test_runs_are_told_apart_by_the_params_they_set():
+    """A group whose name differs shows as ``group=name``; a key one group lacks (``raw`` has no
+    prior) tells runs apart only where it is set and differs."""
+    from toolkit.execution.compare import differing_params, variant_label
+
+    cvae = {"action.name": "cvae", "action.beta": "0.2", "action.prior": "abc", "seed": "0", "task.name": "getup"}
+    nofilter = {**cvae, "action.beta": "1.0", "seed": "1"}
+    raw = {"action.name": "raw", "action.around_start": "False", "seed": "0", "task.name": "getup"}
+    diff = differing_params([cvae, nofilter, raw])
+    assert diff == ["action.name", "action.beta"]
+    assert [variant_label(p, diff) for p in (cvae, nofilter, raw)] == [
+        "action=cvae, action.beta=0.2", "action=cvae, action.beta=1.0", "action=raw"]
+    assert differing_params([cvae, {**cvae, "seed": "5"}]) == []
