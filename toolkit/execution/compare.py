@@ -18,6 +18,7 @@ import numpy as np
 
 from toolkit.errors import JtError
 from toolkit.execution import describe, provenance
+from toolkit.execution.runner import _Terminate
 
 
 @dataclasses.dataclass
@@ -122,6 +123,8 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     run_id = store.start_run(experiment, run_name=store.unique_run_name(experiment, f"compare {label} x{seeds}"),
                              tags={**describe.provenance_tags(command), "jt.compare": "true", "jt.vary": label,
                                    "jt.seeds": str(seeds), describe.NOTE: f"Comparison running: `{command}`\n"})
+    terminate = _Terminate()  # SIGTERM ends the comparison run as KILLED, as Ctrl-C does (not left RUNNING)
+    terminate.__enter__()
     try:
         store.log_params(run_id, _params(overrides, grid, seeds))
         executor = plugins.load("executor", str(base.executor.name))(base.executor)
@@ -142,12 +145,14 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
         out = _record(store, run_id, per_cell, list(getattr(task_cls, "key_metrics", ())), label, command)
         store.end_run(run_id, "FINISHED")
         return out
-    except KeyboardInterrupt:
-        store.end_run(run_id, "KILLED", "interrupted (Ctrl-C)")
+    except KeyboardInterrupt as e:
+        store.end_run(run_id, "KILLED", str(e) or "interrupted (Ctrl-C)")
         raise
     except BaseException as e:
         store.end_run(run_id, "FAILED", f"{type(e).__name__}: {e}")
         raise
+    finally:
+        terminate.__exit__(None, None, None)
 
 
 def differing_params(params: Sequence[dict[str, str]]) -> list[str]:

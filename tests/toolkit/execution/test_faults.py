@@ -277,3 +277,26 @@ def test_a_full_disk_fails_in_one_line_and_resumes_once_freed(example_plugin, te
     ballast.unlink()
     _finish(example_plugin, store, rid)
     _assert_consistent(store, rid, _reference(4, template_db, tmp_path))
+
+
+def test_a_terminated_comparison_ends_killed_with_nothing_left_running(example_plugin, template_db, tmp_path):
+    """SIGTERM to a real ``jt compare`` while two cells run in its pool: the comparison run ends
+    KILLED and nothing is left RUNNING (the comparison and both cells used to stay RUNNING for ever:
+    only ``jt run`` turned SIGTERM into Ctrl-C)."""
+    store = _new_store(template_db, tmp_path / "store")
+    proc = _jt(example_plugin, "compare", "task=quadratic", "executor.workers=2", "task.sleep=4",
+               f"store={store}", "--vary", "task.centre=0.0,0.5")  # two cells at once, in a process pool
+    try:
+        _wait("both cells' runs", lambda: _query(store, "select count(*) from runs where status = 'RUNNING' "
+                                                        "and name not like 'compare%'") == [(2,)])
+        time.sleep(1.5)  # past each cell's opening (a SIGTERM there leaves a run resumable, as it was)
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    rows = dict(_query(store, "select name, status from runs"))
+    compares = [s for n, s in rows.items() if n.startswith("compare")]
+    assert compares == ["KILLED"], rows
+    cells = [s for n, s in rows.items() if not n.startswith("compare")]
+    assert len(cells) == 2 and set(cells) <= {"KILLED", "FINISHED"}, rows  # the pool's cells end, killed or done
