@@ -17,6 +17,9 @@ import numpy as np
 from toolkit.errors import JtError
 
 
+COMPOUND_MAX = 16  #: PyBullet's MAX_COMPOUND_COLLISION_SHAPES: a compound body keeps its first 16 shapes
+
+
 class UnknownName(JtError, KeyError):
     """A link / joint name the character does not have: a one-line ``JtError`` that is also the
     ``KeyError`` callers caught before."""
@@ -208,6 +211,33 @@ class SceneQueries:
         pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
         return int(body)
 
+    def add_boxes(self, half_extents: np.ndarray, positions: np.ndarray, orientations: np.ndarray,
+                  rgba: Sequence[float] = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
+        """Static boxes (half extents ``(n, 3)``, centres ``(n, 3)``, orientations ``(n, 4)``) as
+        compound bodies of up to 16 boxes each (PyBullet's ``MAX_COMPOUND_COLLISION_SHAPES``: it
+        drops the 17th on), a few kB however many (the get-up terrain's 108); their handles."""
+        import pybullet as pb
+
+        kw = {"physicsClientId": self.client}
+        half = np.asarray(half_extents, dtype=float).reshape(-1, 3)
+        pos = np.asarray(positions, dtype=float).reshape(-1, 3)
+        orn = np.asarray(orientations, dtype=float).reshape(-1, 4)
+        if not (len(half) == len(pos) == len(orn)) or len(half) == 0 or not np.all(half > 0):
+            raise ValueError(f"add_boxes needs n >= 1 boxes with positive half extents and as many centres "
+                             f"and orientations, got {len(half)}, {len(pos)}, {len(orn)}")
+        bodies = []
+        for at in range(0, len(half), COMPOUND_MAX):
+            h, p, o = (v[at:at + COMPOUND_MAX].tolist() for v in (half, pos, orn))
+            n = len(h)
+            col = pb.createCollisionShapeArray([pb.GEOM_BOX] * n, halfExtents=h, collisionFramePositions=p,
+                                               collisionFrameOrientations=o, **kw)
+            vis = pb.createVisualShapeArray([pb.GEOM_BOX] * n, halfExtents=h, visualFramePositions=p,
+                                            visualFrameOrientations=o, rgbaColors=[list(rgba)] * n, **kw)
+            body = pb.createMultiBody(0.0, col, vis, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], **kw)
+            pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
+            bodies.append(int(body))
+        return tuple(bodies)
+
     def add_heightfield(self, heights: np.ndarray, cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),
                         friction: float = 0.9) -> int:
         """Static terrain ``heights`` ``(n_x, n_z)`` (m) on a ``cell``-metre grid centred at
@@ -229,14 +259,42 @@ class SceneQueries:
                                       flags=pb.GEOM_CONCAVE_INTERNAL_EDGE, **kw)  # no snags on edges
         mid = 0.5 * (float(h.max()) + float(h.min()))
         pos = [float(origin[0]), float(origin[1]) + mid, float(origin[2])]
-        body = pb.createMultiBody(0.0, col, -1, pos, list(Z_TO_Y), **kw)
+        # A body with no visual shape gets one converted from its collision shape, ~0.9 kB per
+        # height sample in every client (11 MB for the get-up terrain, per env): the physics body
+        # carries a speck 10 m under the ground instead, and the first ``render`` adds the seen
+        # terrain as a twin body that collides with nothing (``_show_terrain``).
+        speck = pb.createVisualShape(pb.GEOM_SPHERE, radius=1e-4, visualFramePosition=[0.0, 0.0, -10.0], **kw)
+        body = pb.createMultiBody(0.0, col, speck, pos, list(Z_TO_Y), **kw)
         pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
+        self.terrain_visuals()[int(body)] = {"shape": int(col), "position": pos, "orientation": list(Z_TO_Y), "twin": None}
         return int(body)
 
-    def remove(self, body: int) -> None:
-        """Remove a scene body added by ``add_box`` / ``add_heightfield``."""
+    def terrain_visuals(self) -> dict:
+        """``{heightfield body: {"shape", "position", "orientation", "twin"}}``; ``twin`` is the
+        id of its drawn twin (None until the first ``render``)."""
+        if not hasattr(self, "_terrain_visuals"):
+            self._terrain_visuals: dict = {}
+        return self._terrain_visuals
+
+    def _show_terrain(self) -> None:
+        """Give every heightfield its visual: a twin body on the same collision shape in collision
+        group 0 with mask 0 (no contacts, no ray hits, nothing added to the step's pairs)."""
         import pybullet as pb
 
+        kw = {"physicsClientId": self.client}
+        for entry in self.terrain_visuals().values():
+            if entry["twin"] is None:
+                twin = pb.createMultiBody(0.0, entry["shape"], -1, entry["position"], entry["orientation"], **kw)
+                pb.setCollisionFilterGroupMask(twin, -1, 0, 0, **kw)
+                entry["twin"] = int(twin)
+
+    def remove(self, body: int) -> None:
+        """Remove a scene body added by ``add_box`` / ``add_boxes`` / ``add_heightfield``."""
+        import pybullet as pb
+
+        entry = self.terrain_visuals().pop(int(body), None)
+        if entry is not None and entry["twin"] is not None:
+            pb.removeBody(entry["twin"], physicsClientId=self.client)
         pb.removeBody(int(body), physicsClientId=self.client)
 
     # ------------------------------------------------------------------ output
@@ -258,6 +316,7 @@ class SceneQueries:
         if target is None:
             pos, _ = pb.getBasePositionAndOrientation(self.character.body_id, physicsClientId=self.client)
             target = [v if math.isfinite(v) else 0.0 for v in pos]
+        self._show_terrain()
         return render_frame(self.client, target, width, height, camera)
 
     # ------------------------------------------------------------------ bullet-only extras

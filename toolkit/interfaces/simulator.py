@@ -222,6 +222,13 @@ class Simulator(Plugin, abc.ABC):
         """A static box (half extents in its own frame, orientation x, y, z, w); its handle."""
         raise NotImplementedError
 
+    def add_boxes(self, half_extents: "np.ndarray", positions: "np.ndarray", orientations: "np.ndarray",
+                  rgba: Sequence[float] = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
+        """Static boxes: half extents ``(n, 3)``, centres ``(n, 3)`` and orientations ``(n, 4)``
+        (x, y, z, w), world frame, as few scene bodies as the simulator allows; their handles
+        (what ``contacts`` names them by)."""
+        raise NotImplementedError
+
     def add_heightfield(self, heights: "np.ndarray", cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),
                         friction: float = 0.9) -> int:
         """Static terrain: ``heights`` ``(n_x, n_z)`` metres on a grid of ``cell`` metres, centred
@@ -229,7 +236,7 @@ class Simulator(Plugin, abc.ABC):
         raise NotImplementedError
 
     def remove(self, body: int) -> None:
-        """Remove a scene body added by ``add_box`` / ``add_heightfield``."""
+        """Remove a scene body added by ``add_box`` / ``add_boxes`` / ``add_heightfield``."""
         raise NotImplementedError
 
     # ------------------------------------------------------------------ output

@@ -151,7 +151,7 @@ def run_bench(task: str, overrides: list[str], rates: list[float], control_steps
             result["env"].append(row)
             say(f"  env at {hz:g} Hz: {row['control_steps_per_s']:.0f} control steps/s, physics share "
                 f"{100 * row['physics_share']:.0f} %")
-    env_fn = _EnvFn(task, overrides)
+    env_fn = _EnvFn(task, overrides, t)
     for n in workers:  # rollout workers in the local executor's process pool
         executor = plugins.load("executor", "local")({"name": "local", "workers": n})
         try:
@@ -169,13 +169,22 @@ def run_bench(task: str, overrides: list[str], rates: list[float], control_steps
 
 
 class _EnvFn:
-    """Picklable ``env_fn(seed)`` composing the task in the worker (plugins through the registry)."""
+    """Picklable ``env_fn(seed)`` for the rollout workers, built as training builds its own: a policy
+    task's env spec is made once here and pickled to the workers with its env class (what
+    ``jt_tasks.policy.train.EnvFactory`` does), so a worker's memory is what it is in a training
+    run; any other task is composed in the worker (plugins through the registry)."""
 
-    def __init__(self, task: str, overrides: list[str]) -> None:
+    def __init__(self, task: str, overrides: list[str], built: Any = None) -> None:
         self.task, self.overrides = task, list(overrides)
         self._task: Any = None
+        self._made: Optional[tuple[type, Any]] = None
+        if built is not None and hasattr(built, "env_class") and hasattr(built, "env_spec"):
+            self._made = (built.env_class, built.env_spec({}))
 
     def __call__(self, seed: int) -> Any:
+        if self._made is not None:
+            env_class, spec = self._made
+            return env_class(spec, seed=seed)
         if self._task is None:
             from toolkit import plugins
             from toolkit.config import compose
@@ -184,7 +193,7 @@ class _EnvFn:
         return self._task.make_env(seed=seed)
 
     def __getstate__(self) -> dict:
-        return {"task": self.task, "overrides": self.overrides, "_task": None}
+        return {"task": self.task, "overrides": self.overrides, "_task": None, "_made": self._made}
 
 
 def format_table(res: dict) -> str:

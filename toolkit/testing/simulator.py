@@ -193,6 +193,35 @@ class SimulatorContract:
         assert flat[1] == pytest.approx(0.0, abs=1e-3)
         assert np.isnan(sim.ray(np.array([[0.0, 5.0, 0.0]]), np.array([[0.0, 4.0, 0.0]]))).all()
 
+    def test_boxes_are_where_they_say(self, sim):
+        """Two boxes, one turned 30° about z (y up): rays find both tops; 40 more are all kept."""
+        import math
+
+        self._lifted(sim, 0.5)
+        a = math.radians(30.0)
+        half = np.array([[0.5, 0.1, 0.5], [1.0, 0.1, 0.5]])
+        pos = np.array([[-10.0, 0.1, -10.0], [-13.0, 0.0, -10.0]])
+        orn = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, math.sin(a / 2), math.cos(a / 2)]])
+        bodies = sim.add_boxes(half, pos, orn)
+        down = np.array([[-10.2, 3.0, -10.0], [-13.0, 3.0, -10.0], [-12.5, 3.0, -10.0]])
+        hits = sim.ray(down, down - [0.0, 6.0, 0.0])
+        assert hits[0, 1] == pytest.approx(0.2, abs=1e-6)  # the flat box's top
+        top_centre = 0.1 / math.cos(a)  # the turned box's top above its centre line
+        assert hits[1, 1] == pytest.approx(top_centre, abs=1e-6)
+        assert hits[2, 1] == pytest.approx(top_centre + 0.5 * math.tan(a), abs=1e-6)  # rising at 30°
+        for body in bodies:
+            sim.remove(body)
+        assert sim.ray(down[:1], down[:1] - [0.0, 6.0, 0.0])[0, 1] == pytest.approx(0.0, abs=1e-6)
+        n = 40  # a row of small boxes, 0.5 m apart, each 0.1 m higher than the last
+        xs = 20.0 + 0.5 * np.arange(n)
+        many = sim.add_boxes(np.tile([0.2, 0.05, 0.2], (n, 1)), np.stack([xs, 0.1 * np.arange(n), np.full(n, 20.0)], 1),
+                             np.tile([0.0, 0.0, 0.0, 1.0], (n, 1)))
+        tops = sim.ray(np.stack([xs, np.full(n, 9.0), np.full(n, 20.0)], 1),
+                       np.stack([xs, np.full(n, -1.0), np.full(n, 20.0)], 1))[:, 1]
+        np.testing.assert_allclose(tops, 0.1 * np.arange(n) + 0.05, atol=1e-6)
+        for body in many:
+            sim.remove(body)
+
     def test_render_is_an_rgb_frame(self, sim):
         self._lifted(sim, 0.1)
         img = sim.render(64, 48)

@@ -65,3 +65,72 @@ def test_rays_through_the_character_find_a_heightfield_under_it(lying):
         np.testing.assert_allclose(hits[dx > 0.1, 1], 0.5, atol=1e-4)
     finally:
         lying.remove(body)
+
+
+def _plateau_sim() -> tuple[BulletSimulator, int]:
+    """A humanoid lying on a 0.4 m plateau heightfield with its edge in the default camera's view."""
+    from jt_tasks.getup.initial import clip_pose
+
+    s = BulletSimulator({"sim": {"name": "bullet"}, "character": {"name": "humanoid"}, "spd": {"name": "df"}})
+    q, qd = clip_pose("getup_faceup", False, 0)
+    q = np.array(q, dtype=float)
+    q[1] += 0.4
+    s.reset(q, qd)
+    heights = np.full((41, 41), 0.4)
+    heights[:, :5] = 0.0
+    return s, s.add_heightfield(heights, 0.1, origin=(0.0, 0.0, 0.0))
+
+
+def test_a_heightfield_is_drawn_as_before_by_a_twin_made_at_the_first_render():
+    """The physics body carries no converted visual (that costs ~0.9 kB per height sample in every
+    env); the first render adds a collision-free twin, and the picture is the one of a heightfield
+    body that converts its own visual."""
+    import pybullet as pb
+
+    s, body = _plateau_sim()
+    try:
+        kw = {"physicsClientId": s.client}
+        (vis,) = pb.getVisualShapeData(body, **kw)
+        assert vis[2] == pb.GEOM_SPHERE  # the speck, not the terrain
+        n_before = pb.getNumBodies(**kw)
+        img = s.render(96, 72)
+        s.render(96, 72)
+        assert pb.getNumBodies(**kw) == n_before + 1  # one twin, made once
+        entry = s.terrain_visuals()[body]
+        assert entry["twin"] is not None
+        # the old way: the physics body converts its own visual (here a second body, the twin hidden)
+        pb.removeBody(entry["twin"], **kw)
+        entry["twin"] = pb.createMultiBody(0.0, entry["shape"], -1, entry["position"], entry["orientation"], **kw)
+        pb.setCollisionFilterGroupMask(entry["twin"], -1, 0, 0, **kw)
+        assert np.abs(s.render(96, 72).astype(int) - img.astype(int)).max() <= 2
+        flat = BulletSimulator({"sim": {"name": "bullet"}, "character": {"name": "humanoid"}, "spd": {"name": "df"}})
+        try:
+            flat.reset(*s.state())
+            assert np.abs(flat.render(96, 72).astype(int) - img.astype(int)).max() > 50  # the terrain shows
+        finally:
+            flat.close()
+    finally:
+        s.close()
+
+
+def test_the_drawn_twin_takes_no_contacts_and_no_rays():
+    """After a render, the character still rests on the physics heightfield alone, rays still stop
+    on it, and removing the heightfield removes its twin."""
+    import pybullet as pb
+
+    s, body = _plateau_sim()
+    try:
+        kw = {"physicsClientId": s.client}
+        s.render(64, 48)
+        twin = s.terrain_visuals()[body]["twin"]
+        for _ in range(60):
+            pb.stepSimulation(**kw)
+        touching = {c[2] for c in pb.getContactPoints(bodyA=s.body_id, **kw)}
+        assert body in touching and twin not in touching
+        hit = pb.rayTest([1.5, 3.0, 1.5], [1.5, -1.0, 1.5], **kw)[0]
+        assert hit[0] == body and hit[3][1] == pytest.approx(0.4, abs=1e-4)
+        n = pb.getNumBodies(**kw)
+        s.remove(body)
+        assert pb.getNumBodies(**kw) == n - 2 and not s.terrain_visuals()
+    finally:
+        s.close()

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+
 from typer.testing import CliRunner
 
 
@@ -38,3 +40,26 @@ def test_bench_rollout_rejects_bad_input():
         assert res.returncode == 2, (args, res.stdout, res.stderr)
         lines = [ln for ln in res.stderr.splitlines() if ln.startswith("jt:")]
         assert len(lines) == 1 and "Traceback" not in res.stderr, res.stderr
+
+
+def test_collection_workers_get_the_spec_built_once_as_training_does():
+    """The bench's ``env_fn`` carries the policy task's env class and the spec made by the driver
+    (what ``jt_tasks.policy.train.EnvFactory`` gives a training run's workers): a worker does not
+    compose the task or build the spec again, so its memory is a training worker's."""
+    import pickle
+
+    from toolkit import plugins
+    from toolkit.config import compose
+    from toolkit.rl.rollout_bench import _EnvFn
+
+    task = plugins.load("task", "highjump")(compose(["task=highjump", "action=raw"]))
+    fn = pickle.loads(pickle.dumps(_EnvFn("highjump", ["action=raw"], task)))
+    assert fn._task is None and fn._made is not None and fn._made[0] is task.env_class
+    assert fn._made[1] == task.env_spec({})
+    env, composed = fn(3), task.make_env(seed=3)
+    try:
+        assert fn._task is None  # built from the shipped spec, nothing composed
+        np.testing.assert_array_equal(env.reset(seed=5)[0], composed.reset(seed=5)[0])
+    finally:
+        env.close()
+        composed.close()

@@ -1,4 +1,4 @@
-"""The get-up terrain (003 §3.2, §5.4): real heightfield regions, seeded; the height map and h follow it."""
+"""The get-up terrain (003 §3.2, §5.4): real PyBullet boxes, seeded; the height map and h follow it."""
 
 from __future__ import annotations
 
@@ -33,9 +33,10 @@ def down_rays(xz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def test_regions_are_rough_and_sloped_as_designed_and_seeded():
     spec = T.TerrainSpec()
-    a, b = T.grid(spec)[2], T.grid(T.TerrainSpec())[2]
+    a, b = T.boxes(spec)[1], T.boxes(T.TerrainSpec())[1]
     np.testing.assert_array_equal(a, b)  # same seed, same heights
-    assert not np.array_equal(a, T.grid(T.TerrainSpec(seed=1))[2])
+    assert not np.array_equal(a, T.boxes(T.TerrainSpec(seed=1))[1])
+    assert len(a) == 3 * (8 * 4 + 4)  # 3 regions: 32 rough tiles, 4 slope faces each
     rng = np.random.default_rng(0)
     for region in range(1, 4):
         xz = T.sample_locations(spec, region, 400, rng)
@@ -50,18 +51,33 @@ def test_regions_are_rough_and_sloped_as_designed_and_seeded():
     assert np.all(flat == 0.0)
 
 
-def test_heightfield_in_pybullet_matches_the_design(world):
+def test_terrain_in_pybullet_is_the_design(world):
+    """Rays anywhere on the terrain (tile edges and ridges included) land on ``heights_at``."""
     sim, spec = world
     rng = np.random.default_rng(1)
+    xs = rng.uniform(spec.size / 2, (spec.n_regions - 0.5) * spec.size, 3000)
+    zs = rng.uniform(-spec.size / 2, spec.size / 2, 3000)
+    hit = sim.ray(*down_rays(np.stack([xs, zs], axis=1)))[:, 1]
+    np.testing.assert_allclose(hit, T.heights_at(spec, xs, zs), atol=1e-3)
+    for region in range(1, 4):  # rough tiles away from their edges: the tops are exact
+        cells = rng.integers(0, [8, 4], (200, 2))
+        pts = [region * spec.size - spec.size / 2, -spec.size / 2] + (cells + rng.uniform(0.1, 0.9, (200, 2))) * spec.tile
+        np.testing.assert_allclose(sim.ray(*down_rays(pts))[:, 1], T.heights_at(spec, pts[:, 0], pts[:, 1]), atol=1e-6)
+
+
+def test_no_hollow_under_the_slopes(world):
+    """Horizontal rays into the sloped half's outer side, under the wave, hit its side face at once:
+    the tilted boxes leave no hollow a fallen character could slide into."""
+    sim, spec = world
     for region in range(1, 4):
-        xz = T.sample_locations(spec, region, 200, rng)
-        # rough: tile centres (flat tops); sloped: anywhere on a face
-        rough = xz[xz[:, 1] < 0]
-        rough = (np.floor((rough - [region * spec.size - spec.size / 2, -spec.size / 2]) / spec.tile) + 0.5) \
-            * spec.tile + [region * spec.size - spec.size / 2, -spec.size / 2]
-        for pts in (rough, xz[xz[:, 1] > 0]):
-            hit = sim.ray(*down_rays(pts))[:, 1]
-            np.testing.assert_allclose(hit, T.heights_at(spec, pts[:, 0], pts[:, 1]), atol=2e-3)
+        x0 = region * spec.size - spec.size / 2
+        xs = x0 + np.linspace(0.2, spec.size - 0.2, 25)
+        ys = 0.9 * T.heights_at(spec, xs, np.full(25, 1.0))
+        starts = np.stack([xs, ys, np.full(25, spec.size / 2 + 1.0)], axis=1)
+        ends = starts.copy()
+        ends[:, 2] = 0.5
+        hit = sim.ray(starts, ends)
+        np.testing.assert_allclose(hit[ys > 0.01, 2], spec.size / 2, atol=1e-3)
 
 
 def test_hard_slope_is_30_degrees(world):
