@@ -212,8 +212,9 @@ class SceneQueries:
         return int(body)
 
     def add_boxes(self, half_extents: np.ndarray, positions: np.ndarray, orientations: np.ndarray,
-                  rgba: Sequence[float] = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
-        """Static boxes (half extents ``(n, 3)``, centres ``(n, 3)``, orientations ``(n, 4)``) as
+                  rgba: Any = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
+        """Static boxes (half extents ``(n, 3)``, centres ``(n, 3)``, orientations ``(n, 4)``,
+        colours ``rgba`` ``(4,)`` or ``(n, 4)``) as
         compound bodies of up to 16 boxes each (PyBullet's ``MAX_COMPOUND_COLLISION_SHAPES``: it
         drops the 17th on), a few kB however many (the get-up terrain's 108); their handles."""
         import pybullet as pb
@@ -225,14 +226,15 @@ class SceneQueries:
         if not (len(half) == len(pos) == len(orn)) or len(half) == 0 or not np.all(half > 0):
             raise ValueError(f"add_boxes needs n >= 1 boxes with positive half extents and as many centres "
                              f"and orientations, got {len(half)}, {len(pos)}, {len(orn)}")
+        colours = np.broadcast_to(np.asarray(rgba, dtype=float).reshape(-1, 4), (len(half), 4))
         bodies = []
         for at in range(0, len(half), COMPOUND_MAX):
-            h, p, o = (v[at:at + COMPOUND_MAX].tolist() for v in (half, pos, orn))
+            h, p, o, c = (v[at:at + COMPOUND_MAX].tolist() for v in (half, pos, orn, colours))
             n = len(h)
             col = pb.createCollisionShapeArray([pb.GEOM_BOX] * n, halfExtents=h, collisionFramePositions=p,
                                                collisionFrameOrientations=o, **kw)
             vis = pb.createVisualShapeArray([pb.GEOM_BOX] * n, halfExtents=h, visualFramePositions=p,
-                                            visualFrameOrientations=o, rgbaColors=[list(rgba)] * n, **kw)
+                                            visualFrameOrientations=o, rgbaColors=c, **kw)
             body = pb.createMultiBody(0.0, col, vis, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], **kw)
             pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
             bodies.append(int(body))

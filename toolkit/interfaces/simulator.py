@@ -223,10 +223,10 @@ class Simulator(Plugin, abc.ABC):
         raise NotImplementedError
 
     def add_boxes(self, half_extents: "np.ndarray", positions: "np.ndarray", orientations: "np.ndarray",
-                  rgba: Sequence[float] = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
+                  rgba: Any = (0.6, 0.6, 0.6, 1.0), friction: float = 0.9) -> tuple[int, ...]:
         """Static boxes: half extents ``(n, 3)``, centres ``(n, 3)`` and orientations ``(n, 4)``
-        (x, y, z, w), world frame, as few scene bodies as the simulator allows; their handles
-        (what ``contacts`` names them by)."""
+        (x, y, z, w), world frame, colours ``rgba`` ``(4,)`` or ``(n, 4)``, as few scene bodies as
+        the simulator allows; their handles (what ``contacts`` names them by)."""
         raise NotImplementedError
 
     def add_heightfield(self, heights: "np.ndarray", cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),

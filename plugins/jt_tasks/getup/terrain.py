@@ -156,7 +156,17 @@ def boxes(spec: TerrainSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def add_terrain(sim: Any, spec: TerrainSpec, friction: float = 1.0) -> tuple[int, ...]:
     """Build the regions ``1..n−1`` on ``sim`` as boxes (``sim.add_boxes``); their handles.
     ``friction``: 003 §3.2, μ = 1.0."""
-    return tuple(int(b) for b in sim.add_boxes(*boxes(spec), friction=friction))
+    half, centres, orns = boxes(spec)
+    return tuple(int(b) for b in sim.add_boxes(half, centres, orns, colours(spec, centres, orns), friction=friction))
+
+
+def colours(spec: TerrainSpec, centres: np.ndarray, orientations: np.ndarray) -> np.ndarray:
+    """RGBA ``(n, 4)`` of the terrain boxes, for pictures: earth tones unlike the grey character,
+    rough tiles in a checkerboard of two shades (their steps show), slope faces a third."""
+    k = np.floor(centres[:, 0] / spec.tile) + np.floor(centres[:, 2] / spec.tile)
+    tile = np.where((k % 2 == 0)[:, None], [0.55, 0.47, 0.36, 1.0], [0.47, 0.40, 0.30, 1.0])
+    tilted = np.abs(orientations[:, 2]) > 1e-9
+    return np.where(tilted[:, None], [0.42, 0.50, 0.33, 1.0], tile)
 
 
 def sample_locations(spec: TerrainSpec, region: int, n: int, rng: np.random.Generator) -> np.ndarray:
