@@ -132,7 +132,9 @@ def bench_rollout(
     spd: str = typer.Option("maba", "--spd", help=f"SPD backend, one of {', '.join(BACKENDS)}."),
     rates: str = typer.Option("10,30", "--rates", help="Control rates (Hz) of the env measurement."),
     steps: int = typer.Option(400, "--steps", help="Timed control steps per rate."),
-    collect_steps: int = typer.Option(64, "--collect-steps", help="Collection steps per env (16 envs per worker)."),
+    collect_steps: int = typer.Option(256, "--collect-steps",
+                                      help="Collection steps per env (16 envs per worker; 256: a 4096-sample PPO "
+                                           "iteration each, long enough for a steady 1 -> 2 worker figure)."),
     workers: str = typer.Option("1,2", "--workers", help="Worker counts of the collection measurement."),
     loops: str = typer.Option("auto", "--loops", help="Comma list of substep loops (sim.loop): auto, compiled, python."),
     repeats: int = typer.Option(3, "--repeats", help="Env measurements per rate (fresh env each); the median is shown."),

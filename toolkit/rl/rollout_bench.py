@@ -78,7 +78,7 @@ def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps:
 
 
 def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: int = 16,
-               n_steps: int = 64, executor: Any = None, seed: int = 0) -> dict[str, float]:
+               n_steps: int = 256, executor: Any = None, seed: int = 0) -> dict[str, float]:
     """PPO collection speed of ``n_workers`` rollout workers with the paper's networks.
 
     Returns:
@@ -134,7 +134,7 @@ def median_breakdown(make_env: Callable[[], Any], control_hz: float, control_ste
 
 
 def run_bench(task: str, overrides: list[str], rates: list[float], control_steps: int = 400,
-              n_steps: int = 64, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None,
+              n_steps: int = 256, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None,
               repeats: int = 3) -> dict:
     """The whole benchmark for one task (see the module docstring); the env measurement is the
     median of ``repeats`` runs; ``echo`` prints progress."""
