@@ -1,0 +1,29 @@
+"""``style_study``: replaying a run's final policy gives the run's own style measures, windowed."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+
+def test_replay_reproduces_the_logged_style_measures_and_windows_are_prefixes(tmp_path):
+    from jt_tasks.spacetime import style_study
+    from toolkit import plugins
+    from toolkit.config import compose
+    from toolkit.interfaces.task import EvalContext
+
+    cfg = compose(["task=spacetime", "experiment=smoke"])
+    ev = plugins.load("task", "spacetime")(cfg).evaluate({}, EvalContext(index=0, seed=3, workdir=tmp_path))
+    env, ro = style_study.replay(cfg, str(tmp_path / "ppo.h5"))
+    try:
+        assert float(ro["info"]["survival_s"]) == pytest.approx(ev.metrics["survival_s"], abs=1e-12)
+        short, whole = style_study.windows(env, ro, [0.2, None])
+    finally:
+        env.close()
+    m = ev.metrics
+    for ours, logged in (("volume", "style_volume"), ("ref_volume", "ref_volume"),
+                         ("energy", "style_energy"), ("ref_energy", "ref_energy")):
+        assert whole[ours] == pytest.approx(m[logged], rel=1e-9)  # the same rollout, the same estimator
+    assert math.isnan(whole["seconds"]) and whole["steps"] == m["survival_steps"] + 1
+    assert short["steps"] == 7 and short["volume"] != whole["volume"]  # 0.2 s at 30 Hz: the first 7 states
