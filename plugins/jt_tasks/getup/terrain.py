@@ -11,7 +11,7 @@ rough and sloped parts; §6.5: the steepest slope is 30°. The amplitudes are no
   **rough**, 1 m tiles with heights uniform in ``[0, roughness[k]]`` (seeded), one flat-topped box
   each (a step at every tile edge); the half ``z ≥ 0`` **sloped**, a triangle wave along x of
   slope ``slope_deg[k]`` and period ``slope_period`` (ridges and valleys parallel to z), one tilted
-  box per face. The boxes are ``heights_at`` exactly. (Until session 9 this was a 0.125 m
+  box per face. The boxes are ``heights_at`` exactly. (Until December 2026 this was a 0.125 m
   heightfield, which smoothed each tile edge into a ramp and cost ~9 MB per environment in
   PyBullet, 140 MB of a 16-env rollout worker; 108 boxes cost ~0.1 MB.)
 * start locations are drawn uniformly in a region, ``margin`` m from its borders (steps between
