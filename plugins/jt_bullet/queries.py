@@ -30,6 +30,10 @@ class UnknownName(JtError, KeyError):
 class SceneQueries:
     """The query, scene and render half of ``toolkit.interfaces.Simulator`` on PyBullet."""
 
+    terrain_visuals: dict
+    """``{heightfield body: {"shape", "position", "orientation", "twin"}}``; ``twin`` is the id of
+    its drawn twin (None until the first ``render``)."""
+
     # ------------------------------------------------------------------ the character
     @property
     def body_id(self) -> int:
@@ -268,15 +272,8 @@ class SceneQueries:
         speck = pb.createVisualShape(pb.GEOM_SPHERE, radius=1e-4, visualFramePosition=[0.0, 0.0, -10.0], **kw)
         body = pb.createMultiBody(0.0, col, speck, pos, list(Z_TO_Y), **kw)
         pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
-        self.terrain_visuals()[int(body)] = {"shape": int(col), "position": pos, "orientation": list(Z_TO_Y), "twin": None}
+        self.terrain_visuals[int(body)] = {"shape": int(col), "position": pos, "orientation": list(Z_TO_Y), "twin": None}
         return int(body)
-
-    def terrain_visuals(self) -> dict:
-        """``{heightfield body: {"shape", "position", "orientation", "twin"}}``; ``twin`` is the
-        id of its drawn twin (None until the first ``render``)."""
-        if not hasattr(self, "_terrain_visuals"):
-            self._terrain_visuals: dict = {}
-        return self._terrain_visuals
 
     def _show_terrain(self) -> None:
         """Give every heightfield its visual: a twin body on the same collision shape in collision
@@ -284,7 +281,7 @@ class SceneQueries:
         import pybullet as pb
 
         kw = {"physicsClientId": self.client}
-        for entry in self.terrain_visuals().values():
+        for entry in self.terrain_visuals.values():
             if entry["twin"] is None:
                 twin = pb.createMultiBody(0.0, entry["shape"], -1, entry["position"], entry["orientation"], **kw)
                 pb.setCollisionFilterGroupMask(twin, -1, 0, 0, **kw)
@@ -294,7 +291,7 @@ class SceneQueries:
         """Remove a scene body added by ``add_box`` / ``add_boxes`` / ``add_heightfield``."""
         import pybullet as pb
 
-        entry = self.terrain_visuals().pop(int(body), None)
+        entry = self.terrain_visuals.pop(int(body), None)
         if entry is not None and entry["twin"] is not None:
             pb.removeBody(entry["twin"], physicsClientId=self.client)
         pb.removeBody(int(body), physicsClientId=self.client)

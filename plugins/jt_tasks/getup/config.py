@@ -132,6 +132,11 @@ class GetupConfig(PolicyConfig):
             v = getattr(self, key)
             require(finite(v) and v >= 0, f"task.{key}", v, "must be a finite number >= 0")
         if self.terrain:
+            known = [f.name for f in dataclasses.fields(TerrainSpec)]
+            for key in self.terrain:
+                why = " (the terrain is boxes, not a heightfield, since December 2026)" if key == "cell" else ""
+                require(key in known, f"task.terrain.{key}", self.terrain[key],
+                        f"is not a terrain key{why}; the keys: {', '.join(known)}")
             try:
                 bad = TerrainSpec.from_dict(dict(self.terrain)).check()
             except TypeError as e:

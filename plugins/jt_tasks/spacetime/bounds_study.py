@@ -23,6 +23,8 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from toolkit.errors import one_line_errors
+
 CLIPS = ("walk", "run", "jump", "roll", "cartwheel", "backflip", "dance_a")
 
 
@@ -79,6 +81,7 @@ def study(clips: Sequence[str] = CLIPS, n_starts: int = 5, seconds: float = 4.0)
     return rows
 
 
+@one_line_errors
 def main(argv: Optional[Sequence[str]] = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--clips", nargs="+", default=list(CLIPS))

@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 from typing import Any, Optional, Sequence
 
+from toolkit.errors import JtError, one_line_errors
+
 
 def replay(config: Any, checkpoint: str) -> tuple[Any, dict[str, Any]]:
     """The final evaluation of a run with ``config`` (its composed config) and policy
@@ -57,7 +59,14 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
     st = Store(store_root(store), must_exist=True)
     out = []
     for rid in run_ids:
+        run = st.get_run(rid)  # an unknown id is one JtError line
+        task = run.data.tags.get("jt.task")
+        if task != "spacetime":
+            raise JtError(f"run {rid} is a {task or 'non-jt'} run; style_study replays task=spacetime runs")
         art = st.artifact_dir(rid)
+        if not (art / "ppo.h5").is_file() or not (art / "config.yaml").is_file():
+            raise JtError(f"run {rid} has no ppo.h5 and config.yaml among its artifacts ({run.info.status}); "
+                          "style_study needs a finished run")
         env, ro = replay(OmegaConf.load(art / "config.yaml"), str(art / "ppo.h5"))
         try:
             for row in windows(env, ro, [*seconds, None]):
@@ -67,15 +76,17 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
     return out
 
 
+@one_line_errors
 def main(argv: Optional[Sequence[str]] = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("runs", nargs="+", help="run ids of finished spacetime runs")
     ap.add_argument("--store", default=None, help="the store (default: $JT_STORE, else ./artifacts)")
     ap.add_argument("--seconds", nargs="*", type=float, default=[0.5, 1.0, 1.5])
     args = ap.parse_args(argv)
+    rows = study(args.runs, args.store, args.seconds)  # errors before any output
     print("| run | survival (s) | window (s) | steps | volume / reference (m³) | energy / reference (J) |")
     print("|---|---|---|---|---|---|")
-    for r in study(args.runs, args.store, args.seconds):
+    for r in rows:
         w = "all" if r["seconds"] != r["seconds"] else f"{r['seconds']:g}"
         print(f"| {r['run'][:8]} | {r['survival_s']:.2f} | {w} | {r['steps']:.0f} | {r['volume']:.4f} / "
               f"{r['ref_volume']:.4f} | {r['energy']:.2f} / {r['ref_energy']:.2f} |")

@@ -96,7 +96,7 @@ def test_a_heightfield_is_drawn_as_before_by_a_twin_made_at_the_first_render():
         img = s.render(96, 72)
         s.render(96, 72)
         assert pb.getNumBodies(**kw) == n_before + 1  # one twin, made once
-        entry = s.terrain_visuals()[body]
+        entry = s.terrain_visuals[body]
         assert entry["twin"] is not None
         # the old way: the physics body converts its own visual (here a second body, the twin hidden)
         pb.removeBody(entry["twin"], **kw)
@@ -122,7 +122,7 @@ def test_the_drawn_twin_takes_no_contacts_and_no_rays():
     try:
         kw = {"physicsClientId": s.client}
         s.render(64, 48)
-        twin = s.terrain_visuals()[body]["twin"]
+        twin = s.terrain_visuals[body]["twin"]
         for _ in range(60):
             pb.stepSimulation(**kw)
         touching = {c[2] for c in pb.getContactPoints(bodyA=s.body_id, **kw)}
@@ -131,6 +131,6 @@ def test_the_drawn_twin_takes_no_contacts_and_no_rays():
         assert hit[0] == body and hit[3][1] == pytest.approx(0.4, abs=1e-4)
         n = pb.getNumBodies(**kw)
         s.remove(body)
-        assert pb.getNumBodies(**kw) == n - 2 and not s.terrain_visuals()
+        assert pb.getNumBodies(**kw) == n - 2 and not s.terrain_visuals
     finally:
         s.close()

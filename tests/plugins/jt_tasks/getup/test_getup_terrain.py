@@ -146,6 +146,9 @@ def test_curriculum_level_bounds_the_regions_visited():
     ("task.eval_locations=0", "task.eval_locations"),
     ("task.terrain.roughness=[0,0.1]", "task.terrain"),
     ("task.train_regions=all", "task.train_regions"),
+    ("task.terrain.slope_deg=[0,10,20,50]", r"slope_deg values must be in \[0, 45\)"),  # boxes: hole-free below 45°
+    ("+task.terrain.cell=0.25", "task.terrain.cell=0.25: is not a terrain key .*boxes"),  # the former heightfield grid
+    ("+task.terrain.sise=9", "task.terrain.sise=9: is not a terrain key; the keys: size, tile"),
 ])
 def test_bad_terrain_input_is_one_line(override, match):
     from toolkit.config import compose, validate

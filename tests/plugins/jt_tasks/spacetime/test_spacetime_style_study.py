@@ -27,3 +27,18 @@ def test_replay_reproduces_the_logged_style_measures_and_windows_are_prefixes(tm
         assert whole[ours] == pytest.approx(m[logged], rel=1e-9)  # the same rollout, the same estimator
     assert math.isnan(whole["seconds"]) and whole["steps"] == m["survival_steps"] + 1
     assert short["steps"] == 7 and short["volume"] != whole["volume"]  # 0.2 s at 30 Hz: the first 7 states
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys):
+    """No store, an unknown run id: one ``jt:`` line on stderr, status 2, nothing printed before it."""
+    from jt_tasks.spacetime import style_study
+    from toolkit.store.tracking import Store
+
+    Store(tmp_path / "store")  # a real, empty store
+    for argv, said in ((["abc", "--store", str(tmp_path / "none")], "no jt store at"),
+                       (["abc", "--store", str(tmp_path / "store")], "no run 'abc'")):
+        with pytest.raises(SystemExit) as e:
+            style_study.main(argv)
+        out, err = capsys.readouterr()
+        assert e.value.code == 2 and out == ""
+        assert err.startswith("jt: ") and said in err and err.count("\n") == 1
