@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import platform
 from pathlib import Path
-from typing import Optional
+from typing import List, Optional
 
 import typer
 
@@ -126,10 +126,15 @@ def bench_ppo(
         raise typer.Exit(1)
 
 
-@bench_app.command("rollout")
+@bench_app.command("rollout", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def bench_rollout(
+    overrides: Optional[List[str]] = typer.Argument(None, help="Hydra overrides added to every task's config "
+                                                    "(e.g. agent.samples_per_iteration=1024), after the bench's own."),
     tasks: str = typer.Option("highjump", "--tasks", help="Comma list of policy tasks (their envs)."),
-    spd: str = typer.Option("maba", "--spd", help=f"SPD backend, one of {', '.join(BACKENDS)}."),
+    spd: str = typer.Option("task", "--spd", help=f"SPD backend: task (the task's own) or one of {', '.join(BACKENDS)}."),
+    action: str = typer.Option("task", "--action",
+                               help="Action space: task (the task's own; one that needs a trained prior, pvae or "
+                                    "cvae, is replaced by raw) or an action group to use."),
     rates: str = typer.Option("10,30", "--rates", help="Control rates (Hz) of the env measurement."),
     steps: int = typer.Option(400, "--steps", help="Timed control steps per rate."),
     collect_steps: int = typer.Option(256, "--collect-steps",
@@ -138,38 +143,61 @@ def bench_rollout(
     workers: str = typer.Option("1,2", "--workers", help="Worker counts of the collection measurement."),
     loops: str = typer.Option("auto", "--loops", help="Comma list of substep loops (sim.loop): auto, compiled, python."),
     repeats: int = typer.Option(3, "--repeats", help="Env measurements per rate (fresh env each); the median is shown."),
+    train_iterations: int = typer.Option(2, "--train-iterations",
+                                         help="PPO iterations of the training measurement (jt run, the task's own "
+                                              "agent, updates included; the first is left out as warm-up); 0: none."),
+    train_workers: str = typer.Option("1,2", "--train-workers", help="agent.n_workers of the training measurement."),
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
 ) -> None:
-    """Where a policy env's time goes per 600 Hz substep, and PPO collection samples/s per worker."""
-    from toolkit import plugins
-    from toolkit.rl.rollout_bench import format_table, run_bench
+    """Where a policy env's time goes per 600 Hz substep and per reset, PPO collection samples/s per
+    worker, and training's samples/s with the PPO updates (as jt run trains)."""
+    from toolkit.config import group_options
+    from toolkit.rl.rollout_bench import check_policy_task, format_table, run_bench, task_overrides
 
-    if len(_split(spd, BACKENDS, "backend")) != 1:
-        raise JtError(f"--spd takes one backend, got {spd!r}; choose from: {', '.join(BACKENDS)}")
+    if spd != "task" and len(_split(spd, BACKENDS, "backend")) != 1:
+        raise JtError(f"--spd takes one backend, got {spd!r}; choose from: task, {', '.join(BACKENDS)}")
+    actions = group_options("action")
+    if action != "task" and action not in actions:
+        raise JtError(f"unknown --action '{action}'; choose from: task, {', '.join(actions)}")
     names = [t.strip() for t in tasks.split(",") if t.strip()]
+    if not names:
+        raise JtError(f"--tasks takes a comma list of policy tasks, got {tasks!r}")
     for t in names:
-        plugins.load("task", t)  # one clear line for an unknown task
+        check_policy_task(t)  # one clear line for an unknown task or one that trains no policy
     try:
         rate_list = [float(r) for r in rates.split(",") if r.strip()]
         worker_list = tuple(int(w) for w in workers.split(",") if w.strip())
+        train_list = tuple(int(w) for w in train_workers.split(",") if w.strip())
     except ValueError:
-        raise JtError(f"--rates and --workers take comma lists of numbers, got {rates!r}, {workers!r}") from None
-    if not rate_list or any(r <= 0 for r in rate_list) or not worker_list or any(w < 1 for w in worker_list):
-        raise JtError("--rates must be positive rates and --workers counts >= 1")
+        raise JtError(f"--rates, --workers and --train-workers take comma lists of numbers, got {rates!r}, "
+                      f"{workers!r}, {train_workers!r}") from None
+    if not rate_list or any(r <= 0 for r in rate_list):
+        raise JtError(f"--rates takes positive control rates (Hz), got {rates!r}")
+    if not worker_list or any(w < 1 for w in worker_list):
+        raise JtError(f"--workers takes worker counts >= 1, got {workers!r}")
     if repeats < 1 or steps < 1:
         raise JtError(f"--repeats and --steps must be >= 1, got {repeats} and {steps}")
+    if train_iterations < 0:
+        raise JtError(f"--train-iterations must be >= 0 (0: no training measurement), got {train_iterations}")
+    if not train_list or any(w < 1 for w in train_list):
+        raise JtError(f"--train-workers takes worker counts >= 1, got {train_workers!r}")
     loop_list = [x.strip() for x in loops.split(",") if x.strip()]
     bad = [x for x in loop_list if x not in ("auto", "compiled", "python")]
     if bad or not loop_list:
         raise JtError(f"--loops {loops!r}: choose from auto, compiled, python (a comma list)")
+    extra = list(overrides or [])
+    dashed = [o for o in extra if o.startswith("-")]
+    if dashed:  # a mistyped option would otherwise read as a Hydra override
+        raise JtError(f"no such option: {dashed[0]} (see: jt bench rollout --help)")
+    plans = [(t, loop, *task_overrides(t, action, spd, [f"sim.loop={loop}", *extra]))  # every config composes first
+             for t in names for loop in loop_list]
     out = {"machine": machine_info(), "results": []}
-    for t in names:
-        for loop in loop_list:
-            typer.echo(f"{t}, sim.loop={loop}: measuring ...")
-            res = run_bench(t, ["action=raw", f"spd={spd}", f"sim.loop={loop}"], rate_list, steps,
-                            collect_steps, worker_list, echo=typer.echo, repeats=repeats)
-            typer.echo(format_table(res))
-            out["results"].append(res)
+    for t, loop, over, header in plans:
+        typer.echo(f"{t}, sim.loop={loop}: measuring ...")
+        res = run_bench(t, over, rate_list, steps, collect_steps, worker_list, echo=typer.echo, repeats=repeats,
+                        train_iterations=train_iterations, train_workers=train_list, header=header)
+        typer.echo(format_table(res))
+        out["results"].append(res)
     if json_out:
         json_out.parent.mkdir(parents=True, exist_ok=True)
         json_out.write_text(json.dumps(out, indent=2))

@@ -1,16 +1,26 @@
-"""``jt bench rollout``: where a policy task's environment spends its time, and PPO's collection speed.
+"""``jt bench rollout``: where a policy task's environment spends its time, PPO's collection speed,
+and what training really does per second, PPO updates included.
 
-Two measurements, in one run, on a task's own environment (``Task.make_env``):
+The task's own configuration (its SPD backend, its action space) unless the caller overrides it; an
+action space that needs a trained prior (``action=pvae|cvae``) falls back to ``action=raw``
+(``task_overrides``), so nothing is trained or looked up before the measurement. Three
+measurements, in one run, on a task's own environment (``Task.make_env``):
 
 * **the env alone**, random actions ``N(0, 0.3²)`` around the action space's centre: control
   steps per second at each control rate, and per 600 Hz substep the time in PyBullet's
   ``stepSimulation`` (physics), the SPD solve, state reads and torque writes (I/O), the NaN check
   and the episode's ``Watch`` (checks), and the rest of the env's Python per control step (env),
-  from the simulator's ``timers``; the physics share is physics over the whole wall time;
+  from the simulator's ``timers``; the physics share is physics over the whole wall time; and
+  every ``env.reset()`` timed apart from ``env.step()``: a reset's cost in control steps and spread
+  over an episode's samples (``env_breakdown``);
 * **PPO collection** with the paper's 1024-512 networks (``PPOConfig`` defaults): samples per
   second of ``n`` ``RolloutWorker`` s (16 envs each, one batched policy forward per step) in the
   ``local`` executor's process pool (one worker too: each in a process of its own, as training
-  runs them), with each worker's peak resident memory.
+  runs them), with each worker's peak resident memory;
+* **training** as ``jt run`` runs it (``training``): the task's own agent preset and networks, from
+  an untrained policy, in a temporary store, its per-iteration ``samples_per_s``, ``collect_s``
+  and ``update_s`` read back from the evaluation's ``ppo.h5``; the first iteration (worker start,
+  numba's cache) is left out of the figures when there are more.
 
 The paper's figure to compare with: Yin et al. 2021 (``000`` §6.2) train one strategy (~1e8
 samples) in "about six hours" on 48 cores: about 96 samples/s per core.
@@ -19,11 +29,89 @@ samples) in "about six hours" on 48 cores: about 96 samples/s per core.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable, Optional
+from pathlib import Path
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
 PAPER_SAMPLES_PER_CORE = 1.0e8 / (6 * 3600) / 48  #: 000 §6.2: ~1e8 samples, ~6 h, 48 cores
+PRIOR_ACTIONS = ("pvae", "cvae")  #: action spaces that need a trained prior (replaced by raw unless asked for)
+EPISODE_LENGTHS = (5, 600)  #: control steps per episode a reset's cost is spread over (reset_us_per_sample_L*)
+UPDATE_SHARE_NOTE = 0.25  #: an update share above this is said in the table
+
+
+def is_policy_task(cls: Any) -> bool:
+    """A task whose evaluation trains PPO on an env of its own (``PolicyTask``: ``env_path`` and
+    ``env_spec``), told without importing the tasks' package."""
+    return bool(getattr(cls, "env_path", "")) and callable(getattr(cls, "env_spec", None))
+
+
+def policy_tasks() -> list[str]:
+    """The installed policy tasks' names, sorted (a broken plugin is left out)."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    out = []
+    for name in plugins.names("task"):
+        try:
+            if is_policy_task(plugins.load("task", name)):
+                out.append(name)
+        except JtError:
+            continue
+    return out
+
+
+def check_policy_task(name: str) -> None:
+    """One ``JtError`` line for a task that is unknown or trains no policy, naming the policy tasks."""
+    from toolkit import plugins
+    from toolkit.errors import JtError, UnknownPlugin
+
+    try:
+        cls = plugins.load("task", name)
+    except UnknownPlugin:
+        cls = None
+    if cls is None or not is_policy_task(cls):
+        what = "unknown task" if cls is None else "task"
+        why = "" if cls is None else " trains no policy"
+        raise JtError(f"{what} '{name}'{why}; jt bench rollout takes a policy task: {', '.join(policy_tasks())}")
+
+
+def task_overrides(task: str, action: str = "task", spd: str = "task",
+                   extra: Sequence[str] = ()) -> tuple[list[str], str]:
+    """The overrides the benchmark runs ``task`` with, and the header line that shows them.
+
+    Args:
+        task: a policy task.
+        action: ``task`` (its own action space, unless that needs a trained prior: ``action=raw``
+            then) or an action space to use.
+        spd: ``task`` (its own backend) or a backend.
+        extra: further overrides (e.g. ``sim.loop=python``), after these.
+
+    Returns:
+        ``(overrides, header)``; e.g. ``["action=raw", "sim.loop=auto"]`` and ``"task=getup
+        action=raw (cvae needs a prior) sim.loop=auto (task's own: spd=df)"``.
+
+    Raises:
+        JtError: the config does not compose (one line).
+    """
+    from toolkit.config import compose, group_of
+
+    extra = list(extra)
+    over = ([] if action == "task" else [f"action={action}"]) + ([] if spd == "task" else [f"spd={spd}"]) + extra
+    cfg = compose([f"task={task}", *over])
+    own_action = str(group_of(group_of(cfg, "action") or {}, "name") or "")
+    asked = action != "task" or any(o.startswith("action=") for o in extra)
+    note = ""
+    if not asked and own_action in PRIOR_ACTIONS:
+        over.insert(0, "action=raw")
+        note = f"({own_action} needs a prior)"
+        cfg = compose([f"task={task}", *over])
+    own = ([f"action={own_action}"] if not asked and not note and own_action else []) + \
+        ([f"spd={group_of(group_of(cfg, 'spd') or {}, 'name')}"] if spd == "task" and
+         not any(o.startswith("spd=") for o in extra) else [])
+    words = [f"task={task}"] + [f"{o} {note}" if o == "action=raw" and note else o for o in over]
+    header = " ".join(words) + (f" (task's own: {', '.join(own)})" if own else "")
+    return over, header
 
 
 def _set_control_rate(env: Any, hz: float) -> bool:
@@ -38,9 +126,17 @@ def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps:
                   seed: int = 0) -> dict[str, float]:
     """Time ``control_steps`` random-action control steps of a fresh env at ``control_hz``.
 
+    Every ``env.reset()`` (the first, and one after each episode's end) is timed apart from the
+    ``env.step()`` calls (``perf_counter`` around each).
+
     Returns:
-        ``control_steps_per_s``, ``substeps``, per-substep ``us_physics``, ``us_spd``, ``us_io``,
-        ``us_checks``, ``us_env``, ``us_total``, and ``physics_share`` (physics / wall).
+        ``control_steps_per_s`` (resets included, as before), ``substeps``, per-substep
+        ``us_physics``, ``us_spd``, ``us_io``, ``us_checks``, ``us_env``, ``us_total`` (over the
+        whole wall time, resets included), ``physics_share`` (physics / wall); and the resets:
+        ``us_per_reset``, ``us_per_step`` (one control step, resets excluded), ``resets`` (count),
+        ``reset_in_steps`` (``us_per_reset / us_per_step``), ``reset_share`` (of the wall time),
+        ``reset_us_per_sample_L5`` and ``reset_us_per_sample_L600`` (a reset's cost spread over an
+        episode of 5 / 600 control steps, µs per sample).
     """
     env = make_env()
     try:
@@ -50,18 +146,28 @@ def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps:
         low, high = env.action_space.low, env.action_space.high
         mid, half = 0.5 * (low + high), 0.5 * (high - low)
 
-        def run(n: int) -> None:
+        def run(n: int) -> tuple[float, float, int]:
+            """``(seconds in step, seconds in reset, resets)`` of ``n`` control steps."""
+            clock = time.perf_counter
+            t = clock()
             env.reset(seed=seed)
+            reset_s, step_s, resets = clock() - t, 0.0, 1
             for _ in range(n):
                 a = np.clip(mid + 0.3 * half * rng.standard_normal(mid.shape), low, high).astype(np.float32)
+                t = clock()
                 _, _, te, tr, _ = env.step(a)
+                step_s += clock() - t
                 if te or tr:
+                    t = clock()
                     env.reset()
+                    reset_s += clock() - t
+                    resets += 1
+            return step_s, reset_s, resets
 
         run(min(50, control_steps))  # warm up numba and the caches
         env.sim.reset_timers()
         t0 = time.perf_counter()
-        run(control_steps)
+        step_s, reset_s, resets = run(control_steps)
         wall = time.perf_counter() - t0
         tm = env.sim.timers
         n = max(int(tm["substeps"]), 1)
@@ -72,9 +178,19 @@ def env_breakdown(make_env: Callable[[], Any], control_hz: float, control_steps:
                    us_checks=max(loop - phys - spd - io, 0.0) / n * 1e6,
                    us_env=max(wall - loop, 0.0) / n * 1e6, us_total=wall / n * 1e6,
                    physics_share=phys / wall)
+        out.update(_reset_figures(reset_s / resets * 1e6, step_s / control_steps * 1e6, float(resets)),
+                   reset_share=reset_s / wall)
         return out
     finally:
         env.close()
+
+
+def _reset_figures(us_per_reset: float, us_per_step: float, resets: float) -> dict[str, float]:
+    """The reset figures of ``env_breakdown`` from a reset's and a control step's time (µs)."""
+    out = {"us_per_reset": us_per_reset, "us_per_step": us_per_step, "resets": resets,
+           "reset_in_steps": us_per_reset / us_per_step if us_per_step > 0 else float("nan")}
+    out.update({f"reset_us_per_sample_L{n}": us_per_reset / n for n in EPISODE_LENGTHS})
+    return out
 
 
 def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: int = 16,
@@ -123,34 +239,44 @@ def median_breakdown(make_env: Callable[[], Any], control_hz: float, control_ste
                      repeats: int = 3) -> dict[str, float]:
     """``env_breakdown`` ``repeats`` times, each on a fresh env: the median of every figure, and
     ``physics_shares`` ``[...]`` of the runs (a 2-core machine's speed drifts between runs; one
-    run's share can be a few points off)."""
+    run's share can be a few points off); ``reset_in_steps`` and the per-sample reset costs are
+    those of the median reset and step times, so they agree with them."""
     rows = [env_breakdown(make_env, control_hz, control_steps) for _ in range(max(1, int(repeats)))]
     rows = [r for r in rows if r]
     if not rows:
         return {}
     out = {k: float(np.median([r[k] for r in rows])) for k in rows[0]}
+    out.update(_reset_figures(out["us_per_reset"], out["us_per_step"], out["resets"]))  # consistent with the medians
     out["physics_shares"] = [float(r["physics_share"]) for r in rows]
     return out
 
 
 def run_bench(task: str, overrides: list[str], rates: list[float], control_steps: int = 400,
               n_steps: int = 256, workers: tuple[int, ...] = (1, 2), echo: Optional[Callable] = None,
-              repeats: int = 3) -> dict:
+              repeats: int = 3, train_iterations: int = 0, train_workers: tuple[int, ...] = (1, 2),
+              store_dir: Optional[Path | str] = None, header: Optional[str] = None) -> dict:
     """The whole benchmark for one task (see the module docstring); the env measurement is the
-    median of ``repeats`` runs; ``echo`` prints progress."""
+    median of ``repeats`` runs; ``echo`` prints progress. With ``train_iterations > 0``, training
+    (``training``) with each of ``train_workers`` rollout workers, in ``store_dir`` (None: a
+    temporary store, removed afterwards). ``header`` is the table's first line (default: the task
+    and ``overrides``; ``task_overrides`` makes one)."""
+    import shutil
+    import tempfile
+
     from toolkit import plugins
     from toolkit.config import compose
 
     say = echo or (lambda s: None)
     cfg = compose([f"task={task}", *overrides])
     t = plugins.load("task", task)(cfg)
-    result: dict[str, Any] = {"task": task, "overrides": overrides, "env": [], "collection": []}
+    result: dict[str, Any] = {"task": task, "overrides": overrides, "env": [], "collection": [], "training": [],
+                              "header": header or f"task={task} {' '.join(overrides)}".rstrip()}
     for hz in rates:
         row = median_breakdown(lambda: t.make_env(seed=0), hz, control_steps, repeats)
         if row:
             result["env"].append(row)
             say(f"  env at {hz:g} Hz: {row['control_steps_per_s']:.0f} control steps/s, physics share "
-                f"{100 * row['physics_share']:.0f} %")
+                f"{100 * row['physics_share']:.0f} %, a reset {row['reset_in_steps']:.1f} control steps")
     env_fn = _EnvFn(task, overrides, t)
     for n in workers:  # rollout workers in the local executor's process pool
         executor = plugins.load("executor", "local")({"name": "local", "workers": n})
@@ -165,6 +291,19 @@ def run_bench(task: str, overrides: list[str], rates: list[float], control_steps
         result["speedup_2_workers"] = col[2]["samples_per_s"] / col[1]["samples_per_s"]
     if 1 in col:
         result["ratio_to_paper_per_core"] = col[1]["samples_per_s"] / PAPER_SAMPLES_PER_CORE
+    if train_iterations > 0 and train_workers:
+        tmp = None if store_dir is not None else tempfile.mkdtemp(prefix="jt-bench-rollout-")
+        try:
+            for n in train_workers:
+                from toolkit.rl.train_bench import training
+
+                row = training(task, overrides, n, train_iterations, store_dir if tmp is None else tmp, say)
+                result["training"].append(row)
+                say(f"  training, {n} worker(s): {row['train_samples_per_s']:.0f} samples/s, update "
+                    f"{100 * row['update_share']:.0f} %")
+        finally:
+            if tmp is not None:
+                shutil.rmtree(tmp, ignore_errors=True)
     return result
 
 
@@ -198,7 +337,7 @@ class _EnvFn:
 
 def format_table(res: dict) -> str:
     """The benchmark as the text table ``jt bench rollout`` prints."""
-    lines = [f"task={res['task']} {' '.join(res['overrides'])}",
+    lines = [res.get("header") or f"task={res['task']} {' '.join(res['overrides'])}",
              f"{'control':>8} {'steps/s':>8} {'physics':>8} {'spd':>6} {'io':>6} {'checks':>7} {'env':>6} "
              f"{'total':>7}  physics share   (µs per 600 Hz substep)"]
     for r in res["env"]:
@@ -207,6 +346,11 @@ def format_table(res: dict) -> str:
                      f"{r['us_total']:>7.1f}  {100 * r['physics_share']:>5.0f} %"
                      + (f" (median of {', '.join(f'{100 * x:.0f}' for x in r['physics_shares'])})"
                         if len(r.get("physics_shares", [])) > 1 else ""))
+        if "us_per_reset" in r:
+            lines.append(f"{'':>8} reset {r['us_per_reset']:.0f} µs = {r['reset_in_steps']:.1f} control steps of "
+                         f"{r['us_per_step']:.0f} µs ({r['resets']:.0f} resets, {100 * r.get('reset_share', 0):.0f} % "
+                         f"of the time); per sample over a 5 / 600-step episode: {r['reset_us_per_sample_L5']:.0f} / "
+                         f"{r['reset_us_per_sample_L600']:.1f} µs")
     for r in res["collection"]:
         lines.append(f"PPO collection (1024-512 nets, 16 envs/worker), {int(r['n_workers'])} worker(s): "
                      f"{r['samples_per_s']:.0f} samples/s ({r['samples_per_s_per_worker']:.0f} per worker), "
@@ -216,4 +360,16 @@ def format_table(res: dict) -> str:
     if "ratio_to_paper_per_core" in res:
         lines.append(f"per core vs the paper's {PAPER_SAMPLES_PER_CORE:.0f} samples/s (000 §6.2: ~1e8 samples, "
                      f"6 h, 48 cores): {res['ratio_to_paper_per_core']:.2f}x")
+    for r in res.get("training", []):
+        nets = f"{'-'.join(map(str, r['policy_hidden']))} nets"
+        n_it = int(r["iterations"])
+        used = ("iteration 1 of 1, warm-up included" if r["warmup_included"] else
+                "iteration 2 of 2" if n_it == 2 else f"iterations 2-{n_it} of {n_it}")
+        lines.append(f"PPO training as jt run (agent={r['agent']}, {nets}, {int(r['samples_per_iteration'])} samples/"
+                     f"iteration), {int(r['n_workers'])} worker(s): {r['train_samples_per_s']:.0f} samples/s with "
+                     f"updates ({used}); collect {100 * r['collect_share']:.0f} %, update "
+                     f"{100 * r['update_share']:.0f} %; wall {r['wall_s']:.0f} s (training {r['train_wall_s']:.0f} s)")
+        if r["update_share"] > UPDATE_SHARE_NOTE:
+            lines.append(f"  PPO update is {100 * r['update_share']:.0f} % of training wall time "
+                         f"({int(r['n_workers'])} worker(s))")
     return "\n".join(lines)
