@@ -161,6 +161,12 @@ class Skeleton:
         exp map through one ``quat_from_expmap`` call (the per-step hot path of every action space)."""
         dofs = np.asarray(dofs, dtype=np.float64)
         sph_dof, sph_q, rev_dof, rev_q = self._conversion_columns()
+        if dofs.ndim == 1 and dofs.shape[0] == self.n_dof:  # one pose: compiled, the same bits
+            from toolkit.motion import kernels
+
+            out = np.empty(self.n_q)
+            kernels.dofs_to_joints(dofs, sph_dof, sph_q, rev_dof, rev_q, out)
+            return out
         out = np.empty(dofs.shape[:-1] + (self.n_q,))
         out[..., rev_q] = dofs[..., rev_dof]
         if len(sph_dof):

@@ -27,7 +27,6 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
-from toolkit.motion import rotations as rot
 
 COM = ("com_x", "com_y", "com_z")
 ROOT = ("root",)
@@ -84,18 +83,42 @@ def _joint_columns(skeleton: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, n
     return cached
 
 
+def _angle_columns(skeleton: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For ``difference``: the pose columns ``(1 + n_spherical, 4)`` of the root and every
+    spherical joint's quaternion, their channels ``(1 + n_spherical,)`` (the root's is 3), and the
+    revolute joints' pose columns; cached on the skeleton."""
+    cached = skeleton.__dict__.get("_bound_angle_columns")
+    if cached is None:
+        sph_at, sph_cols, rev_at, rev_cols = _joint_columns(skeleton)
+        cols = np.vstack([np.arange(3, 7)[None, :], np.asarray(sph_cols, dtype=int).reshape(-1, 4) + 7])
+        at = np.concatenate([[3], 4 + np.asarray(sph_at, dtype=int)]).astype(int)
+        cached = (cols, at, 4 + np.asarray(rev_at, dtype=int), 7 + np.asarray(rev_cols, dtype=int))
+        object.__setattr__(skeleton, "_bound_angle_columns", cached)
+    return cached
+
+
 def difference(skeleton: Any, a: BodyState, b: BodyState) -> np.ndarray:
-    """The 22-channel difference vector ``(n_channels,)`` between two states (all >= 0)."""
-    com = np.abs(np.asarray(a.com, dtype=float) - np.asarray(b.com, dtype=float)).reshape(-1)
-    root = float(rot.quat_angle(a.q[3:7], b.q[3:7]))
-    ja, jb = np.asarray(a.q[7:], dtype=float), np.asarray(b.q[7:], dtype=float)
-    sph_at, sph_cols, rev_at, rev_cols = _joint_columns(skeleton)
-    angles = np.zeros(len(joint_channels(skeleton)))
-    if len(sph_at):  # every spherical joint in one call (row-wise: the same as one call each)
-        angles[sph_at] = rot.quat_angle(ja[sph_cols], jb[sph_cols])
-    angles[rev_at] = np.abs(ja[rev_cols] - jb[rev_cols])
-    ee = np.linalg.norm(np.asarray(a.ee, dtype=float) - np.asarray(b.ee, dtype=float), axis=-1).reshape(-1)
-    return np.concatenate([com, [root], angles, ee])
+    """The 22-channel difference vector ``(n_channels,)`` between two states (all >= 0).
+
+    The root and every spherical joint in one pass: the angle of ``conj(qa) qb``,
+    ``2 atan2(|xyz|, |w|)`` (``quat_angle``), row-wise.
+    """
+    cols, at, rev_at, rev_cols = _angle_columns(skeleton)
+    qa, qb = np.asarray(a.q, dtype=float), np.asarray(b.q, dtype=float)
+    out = np.zeros(4 + len(joint_channels(skeleton)) + len(END_EFFECTOR_NAMES))
+    out[:3] = np.abs(np.asarray(a.com, dtype=float) - np.asarray(b.com, dtype=float)).reshape(-1)
+    ax, ay, az, aw = qa[cols].T
+    bx, by, bz, bw = qb[cols].T
+    # conj(a) * b (quat_relative), the Hamilton product's sums in its order
+    rx = aw * bx - ax * bw - ay * bz + az * by
+    ry = aw * by + ax * bz - ay * bw - az * bx
+    rz = aw * bz - ax * by + ay * bx - az * bw
+    rw = aw * bw + ax * bx + ay * by + az * bz
+    out[at] = 2.0 * np.arctan2(np.sqrt(rx * rx + ry * ry + rz * rz), np.abs(rw))
+    out[rev_at] = np.abs(qa[rev_cols] - qb[rev_cols])
+    e = np.asarray(a.ee, dtype=float) - np.asarray(b.ee, dtype=float)
+    out[-len(END_EFFECTOR_NAMES):] = np.sqrt(np.einsum("ij,ij->i", e, e))
+    return out
 
 
 def _off(value: Any) -> bool:

@@ -36,7 +36,6 @@ frame and the joint velocities.
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any, Optional
 
 import numpy as np
@@ -131,6 +130,7 @@ class SpacetimeEnv(CharacterEnv):
             rules = self._rule(tuple(spec.train_allowed)) if spec.termination == "contact" else ()
         self.limit = max(limit, 1.0 / self.control_hz)
         self.watch = Watch(rules=rules, time_limit=self.limit, time_limit_outcome="truncate")
+        self._inv = None
         self.steps = 0
         self.reward_sum = 0.0
         self.last_d = np.zeros(len(self.names))
@@ -153,16 +153,33 @@ class SpacetimeEnv(CharacterEnv):
         """Reference clip time of the current state (s)."""
         return self.t0 + self.t
 
+    def heading_inverse(self) -> np.ndarray:
+        """The inverse ``(4,)`` of the root's heading rotation now (``heading_quat``), computed once
+        per state: the bounds' end effectors and the observation both use it."""
+        if self._inv is None:
+            q, _ = self.sim.state()
+            self._inv = rot.quat_conjugate(heading_quat(q[3:7], self.axis))
+        return self._inv
+
     def body_state(self) -> bd.BodyState:
         """What the bounds compare of the simulated character now."""
         q, _ = self.sim.state()
         ee = self.sim.link_poses(END_EFFECTORS)[0]
-        return bd.BodyState(q, np.asarray(self.sim.com(), dtype=float), heading_frame(q, ee, self.axis))
+        return bd.BodyState(q, np.asarray(self.sim.com(), dtype=float),
+                            heading_frame(q, ee, self.axis, self.heading_inverse()))
 
     def difference(self) -> np.ndarray:
-        """The 22-channel difference vector to the reference now."""
+        """The 22-channel difference vector to the reference now (``bounds.difference`` of
+        ``body_state()`` and the reference's, in one compiled pass)."""
+        from jt_tasks.spacetime import kernels
+
         ref = self.ref.sample(self.clip_time)
-        return bd.difference(self.skeleton, self.body_state(), bd.BodyState(ref.q, ref.com, ref.ee))
+        q, _ = self.sim.state()
+        ee = self.sim.link_poses(END_EFFECTORS)[0]
+        out = np.zeros(len(self.names))  # the wrists (fixed joints) stay 0
+        kernels.difference(np.asarray(q, dtype=float), np.asarray(self.sim.com(), dtype=float), ee, ref.q, ref.com,
+                           ref.ee, self.axis == "z", *bd._angle_columns(self.skeleton), out)
+        return out
 
     # ------------------------------------------------------------------ gymnasium hooks
     def start(self, options: Optional[dict]) -> dict:
@@ -202,16 +219,14 @@ class SpacetimeEnv(CharacterEnv):
         return super().pd_targets(action)
 
     def observe(self) -> np.ndarray:
+        from jt_tasks.spacetime import kernels
+
         q, qd = self.sim.state()
         pos, orn = self.sim.link_states()
-        hq = heading_quat(q[3:7], self.axis)
-        inv = rot.quat_conjugate(hq)
-        rel = heading_frame(q, pos, self.axis)
-        orn_h = rot.quat_canonical(rot.quat_multiply(np.broadcast_to(inv, orn.shape), orn))
-        parts = [[self.ref.phase(self.clip_time), q[1]], rel.reshape(-1), orn_h.reshape(-1),
-                 rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6]), qd[6:]]
-        obs = np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts])
-        return np.nan_to_num(obs, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
+        obs = np.empty(2 + 7 * len(pos) + len(qd), dtype=np.float32)
+        kernels.observe(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), pos, orn,
+                        self.ref.phase(self.clip_time), self.axis == "z", obs)
+        return obs
 
     def style_reward(self, q: np.ndarray, qd: np.ndarray) -> float:
         """Product of the style terms (1 without any). Their record: ``link_pos`` / ``link_vel`` /
@@ -236,6 +251,7 @@ class SpacetimeEnv(CharacterEnv):
         return out
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
+        self._inv = None
         self.steps += 1
         if self.evaluating:  # the style measures of the evaluation (artifacts.style_measures)
             self._record_body()

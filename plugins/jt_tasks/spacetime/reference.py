@@ -22,6 +22,7 @@ The clip's feet dip a few cm into the ground in places: the whole reference is l
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 import os
@@ -82,12 +83,19 @@ def heading_quat(q_root: np.ndarray, axis: str = "x") -> np.ndarray:
     return np.array([0.0 * sn, 1.0 * sn, 0.0 * sn, cs])
 
 
-def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x") -> np.ndarray:
+def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x",
+                  inv: Optional[np.ndarray] = None) -> np.ndarray:
     """``points (..., 3)`` relative to the ground-projected root ``root_q[:3]`` (height kept), in the
-    root's heading frame."""
-    origin = np.array([root_q[0], 0.0, root_q[2]])
-    inv = rot.quat_conjugate(heading_quat(root_q[3:7], axis))
-    return rot.quat_rotate(inv, np.asarray(points, dtype=float) - origin)
+    root's heading frame; ``inv``: the heading's inverse ``(4,)`` if the caller has it already
+    (``quat_conjugate(heading_quat(root_q[3:7], axis))``)."""
+    x, _, z = root_q[:3].tolist() if isinstance(root_q, np.ndarray) else [float(v) for v in root_q[:3]]
+    if inv is None:
+        inv = rot.quat_conjugate(heading_quat(root_q[3:7], axis))
+    pts = np.array(points, dtype=float)  # points - (x, 0, z), column by column (the same bits)
+    pts[..., 0] -= x
+    pts[..., 1] -= 0.0
+    pts[..., 2] -= z
+    return rot.quat_rotate(inv, pts)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,6 +159,26 @@ class SpacetimeReference:
                                            kin.joint_pos[i, list(END_EFFECTORS)], heading_axis)
                              for i in range(c.n_frames)])
         self._ee[:, :, 1] += self.lift
+        self._times = [float(x) for x in c.times]
+        self._slerp_tables()
+
+    def _slerp_tables(self) -> None:
+        """Per frame pair ``i``, what ``quat_slerp`` computes before the fraction enters: the start
+        rotations ``(n_frames - 1, 1 + n_spherical, 4)`` (root, then every spherical joint,
+        normalised) and the log of the shortest-arc rotation to the next frame ``(..., 3)``, each
+        with the same calls on the same ``(1 + n_spherical, 4)`` rows as the slerp (bit for bit)."""
+        c = self.clip
+        sph = self.skeleton._conversion_columns()[1]  # (n_spherical, 4) quaternion columns
+        self._sph = sph
+        q0s, logs = [], []
+        for i in range(c.n_frames - 1):
+            q0 = rot.quat_normalize(np.vstack([c.root_rot[i], c.joints[i][sph]]))
+            q1 = rot.quat_normalize(np.vstack([c.root_rot[i + 1], c.joints[i + 1][sph]]))
+            q0s.append(q0)
+            logs.append(rot.quat_to_expmap(rot.quat_canonical(rot.quat_relative(q0, q1))))
+        self._slerp_q0, self._slerp_log = np.array(q0s), np.array(logs)
+        self.offset = np.ascontiguousarray(self.offset, dtype=float)
+        self._lift_vec = np.array([0.0, self.lift, 0.0])
 
     # ------------------------------------------------------------------ time
     def phase(self, t: float) -> float:
@@ -166,31 +194,28 @@ class SpacetimeReference:
             local = t - k * T
         else:
             k, local = 0, min(max(t, 0.0), T)
-        times = self.clip.times
-        i = int(np.clip(np.searchsorted(times, local, side="right") - 1, 0, len(times) - 2))
-        frac = float(np.clip((local - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0))
+        times = self._times
+        i = min(max(bisect.bisect_right(times, local) - 1, 0), len(times) - 2)  # np.searchsorted's
+        frac = min(max((local - times[i]) / (times[i + 1] - times[i]), 0.0), 1.0)
         return int(k), i, frac, (not self.loop and t > T)
 
     def sample(self, t: float) -> RefState:
-        """The reference at clip time ``t`` (s; any real number)."""
+        """The reference at clip time ``t`` (s; any real number).
+
+        The same bits as interpolating each frame pair from scratch (``quat_slerp`` of the root and
+        every spherical joint, linear elsewhere): the slerp's fraction-free part comes from
+        ``_slerp_tables``, the rest is ``kernels.sample``.
+        """
+        from jt_tasks.spacetime import kernels
+
         t = float(t)
         k, i, f, held = self._locate(t)
         c = self.clip
-        root_pos = (1 - f) * c.root_pos[i] + f * c.root_pos[i + 1] + k * self.offset
-        root_pos = root_pos + np.array([0.0, self.lift, 0.0])
-        a, b = c.joints[i], c.joints[i + 1]
-        joints = (1 - f) * a + f * b
-        sph = self.skeleton._conversion_columns()[1]  # (n_spherical, 4) quaternion columns
-        # the root and every spherical joint in one slerp (row-wise: the same as one call each)
-        rots = rot.quat_normalize(rot.quat_slerp(np.vstack([c.root_rot[i], a[sph]]),
-                                                 np.vstack([c.root_rot[i + 1], b[sph]]), f))
-        root_rot = rots[0]
-        if len(sph):
-            joints[sph] = rots[1:]
-        qd = np.zeros(self._vel.shape[1]) if held else (1 - f) * self._vel[i] + f * self._vel[i + 1]
-        com = (1 - f) * self._com[i] + f * self._com[i + 1] + k * self.offset
-        ee = (1 - f) * self._ee[i] + f * self._ee[i + 1]
-        return RefState(np.concatenate([root_pos, root_rot, joints]), qd, com, ee, self.phase(t))
+        q, qd = np.empty(7 + c.joints.shape[1]), np.empty(self._vel.shape[1])
+        com, ee = np.empty(3), np.empty((4, 3))
+        kernels.sample(i, f, k, held, self.lift, c.root_pos, c.joints, self._vel, self._com, self._ee,
+                       self.offset, self._slerp_q0, self._slerp_log, self._sph, q, qd, com, ee)
+        return RefState(q, qd, com, ee, self.phase(t))
 
     def at_phase(self, phase: float, cycle: int = 0) -> RefState:
         """The reference at ``phase`` of cycle ``cycle``."""

@@ -1,0 +1,171 @@
+"""Compiled per-step arithmetic of the spacetime env (numba, cached on disk): the reference at a
+clip time, the observation and the bounds' difference vector.
+
+Each kernel does, on scalars, the operations the numpy code it replaces did, in the same order:
+numpy's elementwise products and sums, its 3- and 4-element reductions (sequential) and
+``sin`` / ``cos`` (the C library's, as numpy's here) give the same bits, so the reference state an
+episode starts from is unchanged to the last digit (``test_spacetime_env_golden``). ``atan2``
+(the bounds' angles) may differ from numpy's SIMD ``arctan2`` in the last digit; nothing it feeds
+reaches the dynamics.
+
+Quaternions are ``(x, y, z, w)``, y-up world; the heading is a turn about +y (``reference``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_EPS = 1e-12
+_SMALL = 1e-6
+
+
+@njit(cache=True)
+def heading_inverse(qx: float, qy: float, qz: float, qw: float, axis_z: bool) -> tuple:
+    """The inverse ``(x, y, z, w)`` of ``reference.heading_quat`` of the root quaternion."""
+    if axis_z:
+        a0, a1, a2 = 0.0, 0.0, 1.0
+    else:
+        a0, a1, a2 = 1.0, 0.0, 0.0
+    # quat_rotate(q, a): t = 2 (u x a), a + w t + u x t
+    tx, ty, tz = 2.0 * (qy * a2 - qz * a1), 2.0 * (qz * a0 - qx * a2), 2.0 * (qx * a1 - qy * a0)
+    fx = a0 + qw * tx + (qy * tz - qz * ty)
+    fz = a2 + qw * tz + (qx * ty - qy * tx)
+    yaw = math.atan2(-fz, fx) - math.atan2(-a2, a0)
+    half = 0.5 * yaw
+    sn, cs = math.sin(half), math.cos(half)
+    return -(0.0 * sn), -(1.0 * sn), -(0.0 * sn), cs
+
+
+@njit(cache=True)
+def _rotate(x: float, y: float, z: float, w: float, vx: float, vy: float, vz: float) -> tuple:
+    tx, ty, tz = 2.0 * (y * vz - z * vy), 2.0 * (z * vx - x * vz), 2.0 * (x * vy - y * vx)
+    return vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx)
+
+
+@njit(cache=True)
+def sample(i: int, f: float, k: int, held: bool, lift: float, root_pos: np.ndarray, joints: np.ndarray,
+           vel: np.ndarray, com: np.ndarray, ee: np.ndarray, offset: np.ndarray, q0: np.ndarray,
+           log: np.ndarray, sph: np.ndarray, q_out: np.ndarray, qd_out: np.ndarray, com_out: np.ndarray,
+           ee_out: np.ndarray) -> None:
+    """The reference between frames ``i`` and ``i + 1`` at fraction ``f`` of cycle ``k``.
+
+    Args:
+        root_pos: ``(n_frames, 3)``; joints: ``(n_frames, n_joint_q)``; vel: ``(n_frames, n_dof)``;
+            com: ``(n_frames, 3)`` (lifted); ee: ``(n_frames, 4, 3)`` (lifted); offset: ``(3,)`` per cycle.
+        q0, log: the slerp tables ``(n_frames - 1, 1 + n_spherical, 4)`` / ``(..., 3)`` (root first).
+        sph: ``(n_spherical, 4)`` quaternion columns of the spherical joints in ``joints``.
+        q_out: ``(3 + 4 + n_joint_q,)``; qd_out: ``(n_dof,)``; com_out: ``(3,)``; ee_out: ``(4, 3)``.
+    """
+    g = 1 - f
+    for d in range(3):
+        extra = lift if d == 1 else 0.0
+        q_out[d] = g * root_pos[i, d] + f * root_pos[i + 1, d] + k * offset[d] + extra
+        com_out[d] = g * com[i, d] + f * com[i + 1, d] + k * offset[d]
+    nj = joints.shape[1]
+    for j in range(nj):
+        q_out[7 + j] = g * joints[i, j] + f * joints[i + 1, j]
+    for r in range(q0.shape[1]):
+        v0, v1, v2 = log[i, r, 0] * f, log[i, r, 1] * f, log[i, r, 2] * f
+        theta = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        if theta < _SMALL:
+            scale = 0.5 - theta * theta / 48.0  # numpy squares by multiplying
+        else:
+            scale = math.sin(0.5 * theta) / theta
+        bx, by, bz, bw = v0 * scale, v1 * scale, v2 * scale, math.cos(0.5 * theta)
+        ax, ay, az, aw = q0[i, r, 0], q0[i, r, 1], q0[i, r, 2], q0[i, r, 3]
+        x = aw * bx + ax * bw + ay * bz - az * by
+        y = aw * by - ax * bz + ay * bw + az * bx
+        z = aw * bz + ax * by - ay * bx + az * bw
+        w = aw * bw - ax * bx - ay * by - az * bz
+        n = math.sqrt(x * x + y * y + z * z + w * w)
+        if n > _EPS:
+            m = max(n, _EPS)
+            x, y, z, w = x / m, y / m, z / m, w / m
+        else:
+            x, y, z, w = 0.0, 0.0, 0.0, 1.0
+        if r == 0:
+            q_out[3], q_out[4], q_out[5], q_out[6] = x, y, z, w
+        else:
+            c = sph[r - 1]
+            q_out[7 + c[0]], q_out[7 + c[1]], q_out[7 + c[2]], q_out[7 + c[3]] = x, y, z, w
+    for j in range(qd_out.shape[0]):
+        qd_out[j] = 0.0 if held else g * vel[i, j] + f * vel[i + 1, j]
+    for e in range(4):
+        for d in range(3):
+            ee_out[e, d] = g * ee[i, e, d] + f * ee[i + 1, e, d]
+
+
+@njit(cache=True)
+def _finite(x: float) -> float:
+    return x if math.isfinite(x) else 0.0
+
+
+@njit(cache=True)
+def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, phase: float, axis_z: bool,
+            out: np.ndarray) -> None:
+    """The observation (``SpacetimeEnv.observe``) into ``out`` ``(2 + 7 n + n_dof,)`` float32:
+    phase, root height, link CoMs ``pos`` ``(n, 3)`` relative to the ground-projected root and
+    orientations ``orn`` ``(n, 4)`` (w >= 0) in the heading frame, root velocities in the heading
+    frame, joint velocities; NaN and inf as 0."""
+    ix, iy, iz, iw = heading_inverse(q[3], q[4], q[5], q[6], axis_z)
+    n = pos.shape[0]
+    out[0], out[1] = _finite(phase), _finite(q[1])
+    rx, rz = q[0], q[2]
+    for l in range(n):
+        px, py, pz = _rotate(ix, iy, iz, iw, pos[l, 0] - rx, pos[l, 1] - 0.0, pos[l, 2] - rz)
+        out[2 + 3 * l], out[3 + 3 * l], out[4 + 3 * l] = _finite(px), _finite(py), _finite(pz)
+    o = 2 + 3 * n
+    for l in range(n):
+        bx, by, bz, bw = orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3]
+        x = iw * bx + ix * bw + iy * bz - iz * by
+        y = iw * by - ix * bz + iy * bw + iz * bx
+        z = iw * bz + ix * by - iy * bx + iz * bw
+        w = iw * bw - ix * bx - iy * by - iz * bz
+        if w < 0.0:
+            x, y, z, w = -x, -y, -z, -w
+        out[o + 4 * l], out[o + 4 * l + 1], out[o + 4 * l + 2], out[o + 4 * l + 3] = \
+            _finite(x), _finite(y), _finite(z), _finite(w)
+    o += 4 * n
+    for b in range(2):
+        vx, vy, vz = _rotate(ix, iy, iz, iw, qd[3 * b], qd[3 * b + 1], qd[3 * b + 2])
+        out[o + 3 * b], out[o + 3 * b + 1], out[o + 3 * b + 2] = _finite(vx), _finite(vy), _finite(vz)
+    o += 6
+    for j in range(6, qd.shape[0]):
+        out[o + j - 6] = _finite(qd[j])
+
+
+@njit(cache=True)
+def difference(q: np.ndarray, com: np.ndarray, ee_world: np.ndarray, ref_q: np.ndarray, ref_com: np.ndarray,
+               ref_ee: np.ndarray, axis_z: bool, cols: np.ndarray, at: np.ndarray, rev_at: np.ndarray,
+               rev_cols: np.ndarray, out: np.ndarray) -> None:
+    """The bounds' difference vector (``bounds.difference``) into ``out`` ``(n_channels,)`` (zeros: the
+    fixed joints' channels are left as they are).
+
+    Args:
+        q, com: the character's pose ``(n_q,)`` and CoM ``(3,)``; ee_world: its end effectors ``(4, 3)``
+            (world; put in its heading frame here); ref_q, ref_com, ref_ee: the reference's (its end
+            effectors already in its heading frame).
+        cols, at, rev_at, rev_cols: ``bounds._angle_columns``.
+    """
+    for d in range(3):
+        out[d] = abs(com[d] - ref_com[d])
+    for r in range(cols.shape[0]):
+        c = cols[r]
+        ax, ay, az, aw = q[c[0]], q[c[1]], q[c[2]], q[c[3]]
+        bx, by, bz, bw = ref_q[c[0]], ref_q[c[1]], ref_q[c[2]], ref_q[c[3]]
+        x = aw * bx - ax * bw - ay * bz + az * by
+        y = aw * by + ax * bz - ay * bw - az * bx
+        z = aw * bz - ax * by + ay * bx - az * bw
+        w = aw * bw + ax * bx + ay * by + az * bz
+        out[at[r]] = 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
+    for r in range(rev_at.shape[0]):
+        out[rev_at[r]] = abs(q[rev_cols[r]] - ref_q[rev_cols[r]])
+    ix, iy, iz, iw = heading_inverse(q[3], q[4], q[5], q[6], axis_z)
+    m = out.shape[0] - 4
+    for e in range(4):
+        px, py, pz = _rotate(ix, iy, iz, iw, ee_world[e, 0] - q[0], ee_world[e, 1] - 0.0, ee_world[e, 2] - q[2])
+        dx, dy, dz = px - ref_ee[e, 0], py - ref_ee[e, 1], pz - ref_ee[e, 2]
+        out[m + e] = math.sqrt(dx * dx + dy * dy + dz * dz)

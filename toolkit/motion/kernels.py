@@ -1,0 +1,40 @@
+"""Compiled one-pose rotation conversions (numba, cached on disk) for the envs' per-step paths.
+
+Each does on scalars what the vectorised ``rotations`` function does, in its order (numpy's
+elementwise arithmetic, its sequential 3-element reductions and the C library's ``sin`` / ``cos``,
+which numpy uses here too), so a PD target built here has the same bits as before
+(``tests/toolkit/motion/test_motion_kernels.py`` holds each against the numpy path).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_SMALL = 1e-6  # rotations._SMALL
+
+
+@njit(cache=True)
+def dofs_to_joints(dofs: np.ndarray, sph_dof: np.ndarray, sph_q: np.ndarray, rev_dof: np.ndarray,
+                   rev_q: np.ndarray, out: np.ndarray) -> None:
+    """``Skeleton.dofs_to_joints`` of one pose: dofs ``(n_dof,)`` -> ``out`` ``(n_q,)``.
+
+    Args:
+        sph_dof, sph_q: exp-map columns ``(n_spherical, 3)`` and quaternion columns ``(n_spherical, 4)``.
+        rev_dof, rev_q: the other joints' dof and pose columns ``(n_revolute,)``.
+    """
+    for r in range(rev_dof.shape[0]):
+        out[rev_q[r]] = dofs[rev_dof[r]]
+    for s in range(sph_dof.shape[0]):
+        v0, v1, v2 = dofs[sph_dof[s, 0]], dofs[sph_dof[s, 1]], dofs[sph_dof[s, 2]]
+        theta = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        if theta < _SMALL:
+            scale = 0.5 - theta * theta / 48.0
+        else:
+            scale = math.sin(0.5 * theta) / theta
+        out[sph_q[s, 0]] = v0 * scale
+        out[sph_q[s, 1]] = v1 * scale
+        out[sph_q[s, 2]] = v2 * scale
+        out[sph_q[s, 3]] = math.cos(0.5 * theta)
