@@ -14,7 +14,9 @@ sets φ to ``state`` (a number) or 0. There is no naturalness term (``penalty() 
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
+import math
 import os
 from numbers import Real
 from typing import Any
@@ -82,6 +84,7 @@ class FFCFBCActionSpace(DofActionSpace):
             if j.kind == "spherical":
                 dofs[:, s] = unwrap_expmaps(dofs[:, s])
         self._times = np.asarray(clip.times, dtype=np.float64)
+        self._time_list = [float(x) for x in self._times]
         self._dofs = dofs
         self._phase = 0.0
 
@@ -97,11 +100,11 @@ class FFCFBCActionSpace(DofActionSpace):
     def set_phase(self, phase: float) -> None:
         """Current phase φ of the reference (wrapped for a looping clip, else clamped to [0, 1])."""
         phi = float(phase)
-        if not np.isfinite(phi):
+        if not math.isfinite(phi):
             raise ValueError(f"phase must be finite, got {phase}")
         if self.clip.loop and phi != 1.0:
             phi = phi % 1.0
-        self._phase = float(np.clip(phi, 0.0, 1.0))
+        self._phase = min(max(phi, 0.0), 1.0)
 
     @property
     def phase(self) -> float:
@@ -111,10 +114,10 @@ class FFCFBCActionSpace(DofActionSpace):
         """The FFC output q̂ ``(n_dof,)``: the clip's dofs linearly interpolated at ``phase``."""
         if phase is not None:
             self.set_phase(phase)
-        times = self._times
-        t = self._phase * float(times[-1])
-        i = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
-        w = float(np.clip((t - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0))
+        times = self._time_list
+        t = self._phase * times[-1]
+        i = min(max(bisect.bisect_right(times, t) - 1, 0), len(times) - 2)  # np.searchsorted's
+        w = min(max((t - times[i]) / (times[i + 1] - times[i]), 0.0), 1.0)
         return (1.0 - w) * self._dofs[i] + w * self._dofs[i + 1]
 
     # ---- control -------------------------------------------------------------------------------

@@ -38,3 +38,19 @@ def dofs_to_joints(dofs: np.ndarray, sph_dof: np.ndarray, sph_q: np.ndarray, rev
         out[sph_q[s, 1]] = v1 * scale
         out[sph_q[s, 2]] = v2 * scale
         out[sph_q[s, 3]] = math.cos(0.5 * theta)
+
+
+@njit(cache=True)
+def clip_small_expmaps(dofs: np.ndarray, sph_dof: np.ndarray, low: np.ndarray, high: np.ndarray,
+                       out: np.ndarray) -> bool:
+    """``limits.limit_targets`` of one pose whose exp maps are all canonical already: ``out`` =
+    ``np.clip(dofs, low, high)`` and True; False (``out`` untouched) if an exp map has ``|v|² > π²``
+    (its canonical form needs the numpy path's ``arctan2``)."""
+    for s in range(sph_dof.shape[0]):
+        v0, v1, v2 = dofs[sph_dof[s, 0]], dofs[sph_dof[s, 1]], dofs[sph_dof[s, 2]]
+        if v0 * v0 + v1 * v1 + v2 * v2 > np.pi ** 2:
+            return False
+    for j in range(dofs.shape[0]):
+        x = dofs[j]
+        out[j] = low[j] if x < low[j] else (high[j] if x > high[j] else x)
+    return True

@@ -73,6 +73,13 @@ def canonical_expmaps(skeleton: Skeleton, dofs: np.ndarray) -> np.ndarray:
 def limit_targets(skeleton: Skeleton, dofs: np.ndarray) -> np.ndarray:
     """PD targets ``(..., n_dof)`` within ``joint_limits``: canonical exp maps, clipped angles."""
     low, high = joint_limits(skeleton)
+    d = np.asarray(dofs, dtype=np.float64)
+    if d.shape == low.shape and np.isfinite(d).all():  # one pose (every step's): compiled when nothing wraps
+        from toolkit.motion import kernels
+
+        out = np.empty_like(low)
+        if kernels.clip_small_expmaps(d, _spherical_columns(skeleton.name), low, high, out):
+            return out
     return np.clip(canonical_expmaps(skeleton, dofs), low, high)
 
 

@@ -20,3 +20,16 @@ def test_dofs_to_joints_of_one_pose_has_the_bits_of_the_batched_path(skeleton_na
     one = np.array([sk.dofs_to_joints(d) for d in dofs])
     assert batched.shape == one.shape == (len(dofs), sk.n_q)
     assert np.array_equal(batched.view(np.uint64), one.view(np.uint64))  # signed zeros too
+
+
+def test_limit_targets_of_one_pose_has_the_bits_of_the_batched_path():
+    from toolkit.motion.skeletons import SKELETONS
+    from toolkit.priors.limits import canonical_expmaps, joint_limits, limit_targets
+
+    sk = SKELETONS["humanoid"]
+    low, high = joint_limits(sk)
+    rng = np.random.default_rng(1)
+    dofs = np.concatenate([rng.normal(0, 1.0, (300, sk.n_dof)), rng.normal(0, 3.0, (100, sk.n_dof))])
+    for d in dofs:  # the compiled path where nothing wraps, numpy's where one does: the same bits
+        want = np.clip(canonical_expmaps(sk, d[None, :]), low, high)[0]
+        assert np.array_equal(limit_targets(sk, d).view(np.uint64), want.view(np.uint64))
