@@ -18,6 +18,7 @@ from toolkit.errors import JtError
 
 
 COMPOUND_MAX = 16  #: PyBullet's MAX_COMPOUND_COLLISION_SHAPES: a compound body keeps its first 16 shapes
+RAY_MASK = -1 ^ 1  #: every collision filter group but Bullet's DefaultFilter (1), the group of every dynamic body
 
 
 class UnknownName(JtError, KeyError):
@@ -156,29 +157,75 @@ class SceneQueries:
         """Hit points ``(n, 3)`` of rays ``starts -> ends`` ``(n, 3)`` against the scene, the
         character's own bodies ignored; NaN rows where a ray hits nothing else.
 
-        A ray whose first hit is the character is cast again reporting every hit along it
-        (PyBullet's ``reportHitNumber``: Bullet's all-hits callback, in no particular order) and
-        takes the nearest hit on anything else: a ray through a character lying on the ground
-        reaches the ground under it (re-casting from just past the first hit starts inside the
-        body, which Bullet's ray test then misses on convex shapes).
+        While every other body is static, the rays are first cast with a collision filter mask
+        without Bullet's default group (``RAY_MASK``: the group of every dynamic body, the
+        character's), so a ray through a character lying on the ground reaches the ground under it
+        in one batch. A ray that ends on a ground plane (or on nothing) keeps that hit: the same
+        point as the all-hits cast below. Every other ray (one on a terrain box, where Bullet's
+        closest-hit callback can differ from the all-hits one in the last bits, or any ray while
+        something else moves) takes the general path: one cast against everything, and a ray whose
+        first hit is the character is cast again reporting every hit along it (PyBullet's
+        ``reportHitNumber``: Bullet's all-hits callback, in no particular order) and takes the
+        nearest hit on anything else (re-casting from just past the first hit would start inside
+        the body, which Bullet's ray test then misses on convex shapes).
         """
-        import pybullet as pb
-
         starts, ends = np.asarray(starts, float).reshape(-1, 3), np.asarray(ends, float).reshape(-1, 3)
         out = np.full(starts.shape, np.nan)
-        me, blocked = self.character.body_id, []
-        batch = pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1
+        planes = self._static_planes()
+        if planes is None:
+            rest = np.arange(len(starts))
+        else:
+            rest = []
+            for i, h in enumerate(self._cast(starts, ends, RAY_MASK)):
+                if h[0] < 0 or h[0] in planes:
+                    if h[0] >= 0:
+                        out[i] = h[3]
+                else:
+                    rest.append(i)
+            rest = np.asarray(rest, int)
+        if len(rest):
+            out[rest] = self._rays_general(starts[rest], ends[rest])
+        return out
+
+    def _cast(self, starts: np.ndarray, ends: np.ndarray, mask: int = -1, **kw: Any) -> list:
+        """PyBullet's ``rayTestBatch`` results for rays ``(n, 3)`` in batches of its maximum size."""
+        import pybullet as pb
+
+        batch, hits = pb.MAX_RAY_INTERSECTION_BATCH_SIZE - 1, []
         for i0 in range(0, len(starts), batch):
-            hits = pb.rayTestBatch(starts[i0:i0 + batch].tolist(), ends[i0:i0 + batch].tolist(),
-                                   physicsClientId=self.client)
-            for j, h in enumerate(hits):
-                if h[0] >= 0 and h[0] != me:
-                    out[i0 + j] = h[3]
-                elif h[0] == me:
-                    blocked.append(i0 + j)
+            hits += pb.rayTestBatch(starts[i0:i0 + batch].tolist(), ends[i0:i0 + batch].tolist(),
+                                    collisionFilterMask=mask, physicsClientId=self.client, **kw)
+        return hits
+
+    def _rays_general(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """:meth:`ray` against every body: one cast, then the all-hits cast where the character
+        is hit first."""
+        out = np.full(starts.shape, np.nan)
+        me, blocked = self.character.body_id, []
+        for i, h in enumerate(self._cast(starts, ends)):
+            if h[0] >= 0 and h[0] != me:
+                out[i] = h[3]
+            elif h[0] == me:
+                blocked.append(i)
         if blocked:
             out[blocked] = self._rays_past_character(starts[blocked], ends[blocked])
         return out
+
+    def _static_planes(self) -> frozenset | None:
+        """The ground plane's id (empty without one) while every body but the character is static
+        (has no mass); None while something else moves. Cached until the number of bodies changes
+        or :meth:`remove` removes one."""
+        import pybullet as pb
+
+        n = pb.getNumBodies(physicsClientId=self.client)
+        if self._scene_planes is None or self._scene_planes[0] != n:
+            me, kw = self.character.body_id, {"physicsClientId": self.client}
+            others = [b for b in (pb.getBodyUniqueId(i, **kw) for i in range(n)) if b != me]
+            static = all(pb.getDynamicsInfo(b, link, **kw)[0] == 0.0
+                         for b in others for link in range(-1, pb.getNumJoints(b, **kw)))
+            planes = frozenset([self.ground] if self.ground >= 0 else [])
+            self._scene_planes = (n, planes if static else None)
+        return self._scene_planes[1]
 
     def _rays_past_character(self, starts: np.ndarray, ends: np.ndarray, max_hits: int = 64) -> np.ndarray:
         """Nearest hit ``(n, 3)`` on a body other than the character along each ray (NaN: none), from
@@ -295,6 +342,7 @@ class SceneQueries:
         if entry is not None and entry["twin"] is not None:
             pb.removeBody(entry["twin"], physicsClientId=self.client)
         pb.removeBody(int(body), physicsClientId=self.client)
+        self._scene_planes = None  # a body made next would leave the count as it was
 
     # ------------------------------------------------------------------ output
     def render(self, width: int = 320, height: int = 240, camera: Any = None,

@@ -54,3 +54,30 @@ def clip_small_expmaps(dofs: np.ndarray, sph_dof: np.ndarray, low: np.ndarray, h
         x = dofs[j]
         out[j] = low[j] if x < low[j] else (high[j] if x > high[j] else x)
     return True
+
+
+@njit(cache=True)
+def bspline_basis(s: np.ndarray, knots: np.ndarray, degree: int, out: np.ndarray) -> None:
+    """``splines.basis_matrix`` at ``s`` ``(n,)`` into ``out`` ``(n, n_control)``: its Cox-de Boor
+    recursion with the same operations per basis (the same bits)."""
+    lo, hi = knots[degree], knots[knots.shape[0] - degree - 1]
+    m = knots.shape[0] - 1
+    last = 0
+    for j in range(m):
+        if knots[j] < knots[j + 1]:
+            last = j
+    b = np.empty(m)
+    for r in range(s.shape[0]):
+        x = min(max(s[r], lo), hi)
+        span = min(np.searchsorted(knots, x, side="right") - 1, last)
+        for j in range(m):
+            b[j] = 1.0 if j == span else 0.0
+        for d in range(1, degree + 1):
+            for j in range(m - d):
+                ld = knots[d + j] - knots[j]
+                rd = knots[d + 1 + j] - knots[1 + j]
+                left = (x - knots[j]) / ld if ld > 0 else 0.0
+                right = (knots[d + 1 + j] - x) / rd if rd > 0 else 0.0
+                b[j] = left * b[j] + right * b[j + 1]
+        for j in range(out.shape[1]):
+            out[r, j] = b[j]

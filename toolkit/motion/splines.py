@@ -80,14 +80,27 @@ class BSplineCurve:
 
     def __post_init__(self) -> None:
         self.control = np.asarray(self.control, dtype=np.float64)
+        self._knots = uniform_knots(self.control.shape[0], self.clamped)
 
     @property
     def knots(self) -> np.ndarray:
-        return uniform_knots(self.control.shape[0], self.clamped)
+        return self._knots.copy()
 
     def __call__(self, s) -> np.ndarray:
-        """Curve values ``(...)`` or ``(..., dim)`` at ``s`` ``(...)`` (clamped to ``[0, 1]``)."""
-        b = basis_matrix(s, self.knots)
+        """Curve values ``(...)`` or ``(..., dim)`` at ``s`` ``(...)`` (clamped to ``[0, 1]``).
+
+        A number or a vector of ``s`` (the envs' per-step targets): the basis in one compiled call
+        (``toolkit.motion.kernels.bspline_basis``), then ``tensordot``'s own product (the same bits)."""
+        s = np.asarray(s, dtype=np.float64)
+        if s.ndim <= 1 and np.isfinite(s).all():
+            from toolkit.motion import kernels
+
+            n = self.control.shape[0]
+            b = np.empty((s.size, n))
+            kernels.bspline_basis(s.reshape(-1), self._knots, DEGREE, b)
+            out = np.dot(b, self.control.reshape(n, -1))  # what tensordot computes, reshaped
+            return out.reshape(s.shape + self.control.shape[1:])
+        b = basis_matrix(s, self._knots)
         return np.tensordot(b, self.control, axes=([-1], [0]))
 
     def at_time(self, t, t0: float, duration: float) -> np.ndarray:

@@ -33,3 +33,23 @@ def test_limit_targets_of_one_pose_has_the_bits_of_the_batched_path():
     for d in dofs:  # the compiled path where nothing wraps, numpy's where one does: the same bits
         want = np.clip(canonical_expmaps(sk, d[None, :]), low, high)[0]
         assert np.array_equal(limit_targets(sk, d).view(np.uint64), want.view(np.uint64))
+
+
+@pytest.mark.parametrize("clamped", [True, False])
+@pytest.mark.parametrize("dim", [0, 3])
+def test_compiled_bspline_has_the_bits_of_the_basis_matrix_path(clamped, dim):
+    from toolkit.motion.splines import BSplineCurve, basis_matrix
+
+    rng = np.random.default_rng(2)
+    control = rng.normal(size=(9,) if dim == 0 else (9, dim))
+    c = BSplineCurve(control, clamped)
+    s = np.concatenate([rng.uniform(-0.2, 1.2, 200), [0.0, 1.0, 0.5]])
+    want = np.tensordot(basis_matrix(s, c.knots), control, axes=([-1], [0]))
+    assert np.array_equal(c(s), want)
+    assert c(0.3).shape == want[0].shape
+    assert np.array_equal(c(0.3), np.tensordot(basis_matrix(0.3, c.knots), control, axes=([-1], [0])))
+    b = np.empty((len(s), 9))
+    from toolkit.motion import kernels
+
+    kernels.bspline_basis(s, c.knots, 3, b)
+    assert np.array_equal(b.view(np.uint64), basis_matrix(s, c.knots).view(np.uint64))
