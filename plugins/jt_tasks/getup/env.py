@@ -31,6 +31,7 @@ from typing import Any, Optional
 import numpy as np
 
 from jt_tasks.getup import features as F
+from jt_tasks.getup import kernels
 from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.initial import clip_pose, pick_curve
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
@@ -39,7 +40,7 @@ from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
 
 START_KINDS = ("clip", "fallen", "standing")  #: ``info["start_kind"]`` codes 0, 1, 2
-LOOKAHEAD = (0.0, 0.1, 0.2, 0.3)  #: s, curve targets in the state (003 §3.3.2)
+LOOKAHEAD = np.array([0.0, 0.1, 0.2, 0.3])  #: s, curve targets in the state (003 §3.3.2)
 
 
 @dataclasses.dataclass
@@ -81,6 +82,19 @@ def joint_rotations(q: np.ndarray) -> np.ndarray:
     return np.stack(out)
 
 
+def joint_layout() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where ``joint_rotations`` reads each joint in ``q``: start indices ``(12,)`` (past the 7
+    root coordinates), spherical flags ``(12,)`` and revolute axes ``(12, 3)`` (zero for a
+    spherical joint), for ``kernels.joint_rotations``."""
+    from toolkit.motion.skeletons import HUMANOID, SPHERICAL
+
+    starts = np.array([7 + s.start for s in HUMANOID.q_slices.values()], dtype=np.int64)
+    spherical = np.array([j.kind == SPHERICAL for j in HUMANOID.joints])
+    axes = np.array([(0.0, 0.0, 0.0) if j.kind == SPHERICAL else tuple(j.axis) for j in HUMANOID.joints],
+                    dtype=np.float64)
+    return starts, spherical, axes
+
+
 class GetupEnv(CharacterEnv):
     """Get up from a fallen state tracking the height and torso-angle curves (003)."""
 
@@ -101,6 +115,7 @@ class GetupEnv(CharacterEnv):
         q_stand, qd_stand = clip_pose("getup_facedown", False, frame=-1)
         self.stand_state = (q_stand, np.zeros_like(qd_stand))
         self.neutral = joint_rotations(q_stand)  # q̂ of eq 9: the clip's final standing pose (ours)
+        self._joints = joint_layout()
         self._clip_starts: dict[tuple, tuple] = {}
         self.terrain_level = 0  # highest unlocked region, set by the terrain curriculum (003 §5.4)
         self.region = 0  # the episode's region
@@ -226,19 +241,19 @@ class GetupEnv(CharacterEnv):
         return self._m
 
     def link_velocities(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Link positions, orientations, angular and linear velocities ``(15, ·)`` (world), the
+        """Link positions, orientations, angular and linear velocities ``(16, ·)`` (world), the
         velocities by finite differences over the last control step (cached until the next step:
-        the reward's record and the observation both read them)."""
+        the reward's record and the observation both read them; read-only, not copies)."""
         if self._lv is None:
             pos, orn = self.sim.link_states()
-            if self._prev_links is None:
-                self._lv = pos, orn, np.zeros_like(pos), np.zeros_like(pos)
-            else:
+            w, v = np.zeros_like(pos), np.zeros_like(pos)
+            if self._prev_links is not None:
                 p0, o0 = self._prev_links
-                v = (pos - p0) / self.dt
-                w = rot.quat_to_expmap(rot.quat_multiply(orn, rot.quat_conjugate(o0))) / self.dt
-                self._lv = pos, orn, w, v
-        return tuple(a.copy() for a in self._lv)
+                kernels.link_velocities(pos, orn, p0, o0, self.dt, w, v)
+            for a in (pos, orn, w, v):
+                a.flags.writeable = False
+            self._lv = pos, orn, w, v
+        return self._lv
 
     def targets(self, t: Any) -> np.ndarray:
         """Curve targets ``(…, 3)`` at episode time(s) ``t``."""
@@ -248,7 +263,8 @@ class GetupEnv(CharacterEnv):
     def pd_targets(self, action: np.ndarray) -> np.ndarray:
         if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
             self.action_space_.set_condition(self.targets(self.t))
-        self._prev_links = self.sim.link_states()
+        # the links now, as the observation of this state read them (the same state: no new query)
+        self._prev_links = self._lv[:2] if self._lv is not None else self.sim.link_states()
         self._lv = None
         self.last_action = np.asarray(action, dtype=np.float64).copy()
         return super().pd_targets(action)
@@ -256,15 +272,18 @@ class GetupEnv(CharacterEnv):
     def observe(self) -> np.ndarray:
         m = self.measure()
         pos, orn, w, v = self.link_velocities()
-        R = F.heading_rotation(m["yaw"])
-        hq = rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), m["yaw"])
-        q_local = rot.quat_canonical(rot.quat_multiply(rot.quat_conjugate(hq)[None, :], orn))
-        p_local = (pos - pos[0]) @ R.T
-        targets = self.targets(self.t + np.array(LOOKAHEAD))
+        n = pos.shape[0]
         prev = getattr(self.action_space_, "filtered", None)
         prev = self.last_action if prev is None else prev
-        parts = [q_local, p_local, w @ R.T, v @ R.T, m["features"], m["heightmap"], targets, prev]
-        return np.concatenate([np.asarray(x, dtype=np.float64).reshape(-1) for x in parts]).astype(np.float32)
+        feats, hmap = m["features"], m["heightmap"]
+        out = np.empty(13 * n + feats.size + hmap.size + 3 * len(LOOKAHEAD) + np.size(prev))
+        kernels.observe_links(pos, orn, w, v, float(m["yaw"]), out)  # orientations, positions, w, v
+        k = 13 * n
+        for x in (feats, hmap, self.targets(self.t + LOOKAHEAD), prev):
+            x = np.asarray(x, dtype=np.float64).reshape(-1)
+            out[k:k + x.size] = x
+            k += x.size
+        return out.astype(np.float32)
 
     def record_now(self) -> dict[str, Any]:
         """The reward terms' record of the current state."""
@@ -275,8 +294,14 @@ class GetupEnv(CharacterEnv):
         h, tx, tz = (float(x) for x in m["features"])
         return {"h": h, "theta_x": tx, "theta_z": tz, "target_h": float(tgt[0]), "target_theta_x": float(tgt[1]),
                 "target_theta_z": float(tgt[2]), "target_h_end": float(end[0]), "link_ang_vel": w,
-                "joint_rotations": joint_rotations(q), "neutral_rotations": self.neutral,
+                "joint_rotations": self._joint_rotations(q), "neutral_rotations": self.neutral,
                 "naturalness": float(min(max(self.penalty, 0.0), 1.0))}
+
+    def _joint_rotations(self, q: np.ndarray) -> np.ndarray:
+        """``joint_rotations(q)`` compiled ``(12, 4)``."""
+        out = np.empty((len(self._joints[0]), 4))
+        kernels.joint_rotations(np.asarray(q, dtype=np.float64), *self._joints, out)
+        return out
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
         self._m = self._lv = None

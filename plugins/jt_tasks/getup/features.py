@@ -93,16 +93,16 @@ def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0) 
         the ground at each grid point, ``003`` §3.2), ``ground`` ``(n * n,)`` terrain heights,
         ``neck``, ``r_hip``, ``l_hip`` ``(3,)``.
     """
+    from jt_tasks.getup import kernels
+
     neck, r_hip, l_hip = sim.link_poses((NECK_LINK, RIGHT_HIP_LINK, LEFT_HIP_LINK))[0]
-    hips = 0.5 * (r_hip + l_hip)
-    yaw = heading_yaw(neck, r_hip, l_hip)
-    pts = heightmap_points(hips, yaw, n, spacing)
-    starts, ends = pts.copy(), pts.copy()
-    starts[:, 1] = hips[1] + ray_span
-    ends[:, 1] = hips[1] - ray_span
+    starts, ends, torso = np.empty((n * n, 3)), np.empty((n * n, 3)), np.empty(6)
+    # heading_yaw, heightmap_points and torso_vectors in one compiled pass (the same formulas)
+    yaw = kernels.frame(neck, r_hip, l_hip, n, spacing, ray_span, SIDE_FALLBACK, starts, ends, torso)
     ground = ground_heights(sim, starts, ends)
-    feats = style_features(neck, r_hip, l_hip, float(np.mean(ground)))
-    return {"features": feats, "yaw": yaw, "heightmap": hips[1] - ground, "ground": ground,
+    feats = np.array([float(neck[1]) - float(np.mean(ground)), kernels.angle_to_up(*torso[:3].tolist()),
+                      kernels.angle_to_up(*torso[3:].tolist())])
+    return {"features": feats, "yaw": yaw, "heightmap": 0.5 * (r_hip[1] + l_hip[1]) - ground, "ground": ground,
             "neck": neck, "r_hip": r_hip, "l_hip": l_hip}
 
 

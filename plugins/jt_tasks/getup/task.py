@@ -13,7 +13,6 @@ not terminated early, from a fallen start (clip or rag-doll), whose neck height 
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from pathlib import Path
