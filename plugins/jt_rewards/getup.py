@@ -38,6 +38,17 @@ def rotation_angles(q: np.ndarray, q_hat: np.ndarray) -> np.ndarray:
     q_hat = np.asarray(q_hat, dtype=np.float64).reshape(-1, 4)
     if q.shape != q_hat.shape:
         raise ValueError(f"joint rotations {q.shape} and neutral rotations {q_hat.shape} differ")
+    from jt_rewards import kernels
+
+    out = np.empty(len(q))
+    kernels.rotation_angles(q, q_hat, out)  # every step: the formula below, compiled
+    return out
+
+
+def rotation_angles_numpy(q: np.ndarray, q_hat: np.ndarray) -> np.ndarray:
+    """:func:`rotation_angles` in numpy (the reference the compiled kernel is held to)."""
+    q = np.asarray(q, dtype=np.float64).reshape(-1, 4)
+    q_hat = np.asarray(q_hat, dtype=np.float64).reshape(-1, 4)
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
     q_hat = q_hat / np.linalg.norm(q_hat, axis=1, keepdims=True)
     dot = np.abs(np.sum(q * q_hat, axis=1))  # |w| of q̂⁻¹ q

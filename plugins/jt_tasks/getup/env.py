@@ -108,7 +108,7 @@ class GetupEnv(CharacterEnv):
         self.curve_starts = np.array([c.start for c in self.curves])
         self.control_hz = float(self.sim.control_hz)
         self.dt = 1.0 / self.control_hz
-        self._m = self._lv = None  # this state's measurements and link velocities (cached per step)
+        self._m = self._lv = self._ahead = None  # this state's measurements, link velocities, targets
         terms = dict((spec.reward or {}).get("terms") or {})
         self.terms = {str(k): plugins.load("reward", str(k))(v) for k, v in terms.items()}
         self.natural = set(spec.natural_terms)
@@ -162,7 +162,8 @@ class GetupEnv(CharacterEnv):
         self.log: list[dict[str, float]] = []
         self.last_action = np.zeros(self.action_space.shape, dtype=np.float64)
         self._prev_links = None
-        self._m = self._lv = None
+        self._m = self._lv = self._ahead = None
+        self.curve_end = c.end  # p(1), read by every step's reward record
         self.supine = bool(self.measure()["features"][2] < math.pi / 2)
         self.head_down_at_start = self._head_contact() or self._head_height() < 0.15
 
@@ -259,6 +260,14 @@ class GetupEnv(CharacterEnv):
         """Curve targets ``(…, 3)`` at episode time(s) ``t``."""
         return self.curve(t)
 
+    def targets_ahead(self) -> np.ndarray:
+        """Curve targets ``(4, 3)`` now and ``LOOKAHEAD`` s ahead (cached until the next step: the
+        reward record reads the first row, the observation all four)."""
+        if self._ahead is None:
+            self._ahead = self.targets(self.t + LOOKAHEAD)
+            self._ahead.flags.writeable = False
+        return self._ahead
+
     # ------------------------------------------------------------------ gymnasium hooks
     def pd_targets(self, action: np.ndarray) -> np.ndarray:
         if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
@@ -279,7 +288,7 @@ class GetupEnv(CharacterEnv):
         out = np.empty(13 * n + feats.size + hmap.size + 3 * len(LOOKAHEAD) + np.size(prev))
         kernels.observe_links(pos, orn, w, v, float(m["yaw"]), out)  # orientations, positions, w, v
         k = 13 * n
-        for x in (feats, hmap, self.targets(self.t + LOOKAHEAD), prev):
+        for x in (feats, hmap, self.targets_ahead(), prev):
             x = np.asarray(x, dtype=np.float64).reshape(-1)
             out[k:k + x.size] = x
             k += x.size
@@ -290,7 +299,7 @@ class GetupEnv(CharacterEnv):
         m = self.measure()
         q, _ = self.sim.state()
         _, _, w, _ = self.link_velocities()
-        tgt, end = self.targets(self.t), self.curve.end
+        tgt, end = self.targets_ahead()[0], self.curve_end
         h, tx, tz = (float(x) for x in m["features"])
         return {"h": h, "theta_x": tx, "theta_z": tz, "target_h": float(tgt[0]), "target_theta_x": float(tgt[1]),
                 "target_theta_z": float(tgt[2]), "target_h_end": float(end[0]), "link_ang_vel": w,
@@ -304,7 +313,7 @@ class GetupEnv(CharacterEnv):
         return out
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
-        self._m = self._lv = None
+        self._m = self._lv = self._ahead = None
         spec = self.spec_
         if rec["failed"]:
             return 0.0, True, False, self._final(f"simulator: {rec['reason']}", False)
