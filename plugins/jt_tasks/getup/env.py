@@ -241,6 +241,13 @@ class GetupEnv(CharacterEnv):
             self._m = self._measure_now()
         return self._m
 
+    def state_changed(self, prev_links: Optional[tuple] = None) -> None:
+        """Forget this step's measurements, link velocities and curve targets after the state or
+        the clock was set from outside a step (a kinematic replay); ``prev_links`` are the link
+        states the next velocities difference against (None: zero velocities)."""
+        self._prev_links = prev_links
+        self._m = self._lv = self._ahead = None
+
     def link_velocities(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Link positions, orientations, angular and linear velocities ``(16, ·)`` (world), the
         velocities by finite differences over the last control step (cached until the next step:

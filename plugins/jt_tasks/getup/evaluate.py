@@ -139,8 +139,8 @@ def replay_reference(env: Any, curve: str) -> dict[str, np.ndarray]:
         p, r, j, v, w, jv = reference_state(clip, t)
         links = env.sim.link_states() if k else None
         env.sim.reset(lift_to_ground(np.concatenate([p, r, j])), np.concatenate([v, w, jv]))
-        env._prev_links, env._m, env._lv = links, None, None
         env.t_offset = k / env.control_hz - float(env.sim.time)  # the curve's clock at this frame
+        env.state_changed(links)
         rec = env.record_now()
         values = {name: float(term(rec)) for name, term in env.terms.items()}
         rows.append({"time": k / env.control_hz,
