@@ -10,6 +10,12 @@ frame's) so that linear interpolation never crosses the ``|v| = π`` seam.
 The phase ``φ ∈ [0, 1]`` comes from ``obs["phase"]`` / ``obs.phase`` / a bare number passed as
 ``obs``, or from ``set_phase``; a looping clip wraps φ, a non-looping one clamps it. ``reset(state)``
 sets φ to ``state`` (a number) or 0. There is no naturalness term (``penalty() == 1``).
+
+``output_scale: range`` (default, the authors' code): the policy network's output is multiplied
+per DoF by the joint's range in the authors' humanoid character file (``a_std = LimHigh −
+LimLow``, 2–4.14 rad, ``JOINT_RANGES``) before it is the mean correction; the exploration noise
+stays in radians (σ = 0.1). The environment exposes it as ``policy_output_scale`` for PPO's
+networks. ``none``: the network's output is the correction.
 """
 
 from __future__ import annotations
@@ -41,6 +47,17 @@ def resolve_clip(name: str) -> str:
     raise JtError(f"action=ffc_fbc: no clip '{name}'; give a path or one of: {', '.join(known)}")
 
 
+#: rad, per joint DoF: LimHigh − LimLow of the authors' humanoid3d character file (the actor's
+#: a_std; 002 authors' code, DeepMimic's humanoid), x, y, z of each exp map, the revolute angle
+JOINT_RANGES = {
+    "chest": (2.4, 2.4, 2.4), "neck": (2.0, 2.0, 2.0),
+    "right_hip": (2.4, 2.0, 4.14), "right_knee": (3.14,), "right_ankle": (2.0, 2.0, 3.14),
+    "right_shoulder": (3.64, 3.0, 3.84), "right_elbow": (3.14,),
+    "left_hip": (2.4, 2.0, 4.14), "left_knee": (3.14,), "left_ankle": (2.0, 2.0, 3.14),
+    "left_shoulder": (3.64, 3.0, 3.84), "left_elbow": (3.14,),
+}
+
+
 def unwrap_expmaps(v: np.ndarray) -> np.ndarray:
     """Exp maps ``(n, 3)`` made continuous along the first axis (same rotations)."""
     out = np.array(v, dtype=np.float64, copy=True)
@@ -69,6 +86,13 @@ class FFCFBCActionSpace(DofActionSpace):
         beta: float = 1.0
         """Action filter y_t = beta a_t + (1 - beta) y_{t-1} (003 §3.4's, an option of every action
         space); 1: no filter (002 filters nothing)."""
+        output_scale: str = "range"
+        """range: the policy's output times each DoF's joint range (authors' code, a_std); none: 1."""
+
+        def check(self) -> None:
+            super().check()
+            if self.output_scale not in ("range", "none"):
+                raise JtError(f"action.output_scale={self.output_scale!r}: range (the authors' joint ranges) or none")
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)
@@ -91,6 +115,20 @@ class FFCFBCActionSpace(DofActionSpace):
     @property
     def dim(self) -> int:
         return self.n_dof
+
+    def output_scale(self) -> np.ndarray | None:
+        """``(n_dof,)`` factors on the policy's output (``JOINT_RANGES``), or None (``none``)."""
+        if self.params.output_scale == "none":
+            return None
+        missing = [j.name for j in self.skeleton.joints if j.kind != "fixed" and j.name not in JOINT_RANGES]
+        if missing:
+            raise JtError(f"action.output_scale=range: no authors' range for joint(s) {', '.join(missing)} "
+                          f"of the {self.skeleton.name}; use action.output_scale=none")
+        out = np.ones(self.n_dof)
+        for j, s in zip(self.skeleton.joints, self.skeleton.dof_slices.values()):
+            if j.name in JOINT_RANGES:
+                out[s] = JOINT_RANGES[j.name]
+        return out
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         high = np.full(self.n_dof, float(self.params.correction_bound))

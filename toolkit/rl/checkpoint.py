@@ -198,6 +198,7 @@ def load_policy(path: str | os.PathLike) -> Any:
     model = ActorCritic(
         int(attrs["obs_dim"]), int(attrs["act_dim"]), cfg["policy_hidden"], cfg["value_hidden"],
         np.asarray(attrs["low"]), np.asarray(attrs["high"]), cfg["normalize_actions"],
+        None if attrs.get("out_scale") is None else np.asarray(attrs["out_scale"]),
     )
     load_networks(groups, model)
     return model
@@ -242,6 +243,8 @@ def save_training(
     n_envs = cfg.n_workers * cfg.envs_per_worker
     attrs: dict[str, Any] = {"config": cfg.to_dict(), "obs_dim": model.obs_dim, "act_dim": model.act_dim,
                              "low": low, "high": high}
+    if model.out_scale is not None:
+        attrs["out_scale"] = model.out_scale
     if warm_start is not None:
         attrs["warm_start"] = str(warm_start)
     return save(path, {

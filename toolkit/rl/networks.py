@@ -11,6 +11,11 @@ stored and scored (log-probabilities, PPO ratios). Only the copy sent to the env
 onto its ``Box``: by default (``normalize_actions=False``) the policy works in the environment's own
 units and the action is clipped to ``[low, high]``; with ``normalize_actions=True`` the policy works
 in ``[-1, 1]`` units, mapped affinely onto ``[low, high]`` and then clipped.
+
+Output scale: an environment may declare ``policy_output_scale`` ``(act_dim,)``; the policy MLP's
+output is multiplied by it before it is the Gaussian's mean, while ``sigma`` stays in the
+environment's units (the authors' code of ``002`` scales the feedback network by each joint's
+range ``a_std`` this way, so an SGD step moves the mean ~``a_std**2`` times further). None: 1.
 """
 
 from __future__ import annotations
@@ -23,6 +28,12 @@ import torch
 from torch import nn
 
 LOG_2PI = math.log(2.0 * math.pi)
+
+
+def output_scale_of(env: "object") -> "np.ndarray | None":
+    """An environment's ``policy_output_scale`` ``(act_dim,)`` (also through wrappers), or None."""
+    scale = getattr(getattr(env, "unwrapped", env), "policy_output_scale", None)
+    return None if scale is None else np.asarray(scale, dtype=np.float64).reshape(-1)
 
 
 def mlp(in_dim: int, hidden: Sequence[int], out_dim: int, out_gain: float) -> nn.Sequential:
@@ -136,6 +147,7 @@ class ActorCritic(nn.Module):
         low: ``(act_dim,)`` lower bounds of the environment's Box.
         high: ``(act_dim,)`` upper bounds.
         normalize_actions: policy works in ``[-1, 1]`` units mapped onto ``[low, high]``.
+        out_scale: ``(act_dim,)`` factors on the policy MLP's output (module docstring); None: 1.
     """
 
     def __init__(
@@ -147,6 +159,7 @@ class ActorCritic(nn.Module):
         low: np.ndarray,
         high: np.ndarray,
         normalize_actions: bool = False,
+        out_scale: "np.ndarray | None" = None,
     ) -> None:
         super().__init__()
         self.obs_dim, self.act_dim = int(obs_dim), int(act_dim)
@@ -156,15 +169,21 @@ class ActorCritic(nn.Module):
         self.low = np.asarray(low, dtype=np.float64).reshape(act_dim)
         self.high = np.asarray(high, dtype=np.float64).reshape(act_dim)
         self.normalize_actions = bool(normalize_actions)
+        self.out_scale = None if out_scale is None else np.asarray(out_scale, dtype=np.float64).reshape(act_dim)
+        self._scale = None if out_scale is None else torch.as_tensor(self.out_scale, dtype=torch.float32)
+
+    def _mean(self, x: torch.Tensor) -> torch.Tensor:
+        mu = self.pi(x)
+        return mu if self._scale is None else mu * self._scale
 
     def forward(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Policy means ``(batch, act_dim)`` and values ``(batch,)`` for raw ``obs``."""
         x = self.norm(obs)
-        return self.pi(x), self.v(x).squeeze(-1)
+        return self._mean(x), self.v(x).squeeze(-1)
 
     def mean_action(self, obs: torch.Tensor) -> torch.Tensor:
         """Policy means ``(batch, act_dim)`` (the deterministic action, before bounds)."""
-        return self.pi(self.norm(obs))
+        return self._mean(self.norm(obs))
 
     def value(self, obs: torch.Tensor) -> torch.Tensor:
         """State values ``(batch,)``."""

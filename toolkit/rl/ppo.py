@@ -226,8 +226,10 @@ def ppo_update(
     return out
 
 
-def _probe(env_fn: Callable[[int], Any], seed: int) -> tuple[int, int, np.ndarray, np.ndarray]:
+def _probe(env_fn: Callable[[int], Any], seed: int) -> tuple[int, int, np.ndarray, np.ndarray, Any]:
     import gymnasium
+
+    from toolkit.rl.networks import output_scale_of
 
     env = env_fn(seed)
     try:
@@ -235,7 +237,8 @@ def _probe(env_fn: Callable[[int], Any], seed: int) -> tuple[int, int, np.ndarra
         if not isinstance(space, gymnasium.spaces.Box):
             raise TypeError(f"PPO needs a continuous Box action space, got {space}")
         return (int(np.prod(env.observation_space.shape)), int(np.prod(space.shape)),
-                np.asarray(space.low, np.float64).reshape(-1), np.asarray(space.high, np.float64).reshape(-1))
+                np.asarray(space.low, np.float64).reshape(-1), np.asarray(space.high, np.float64).reshape(-1),
+                output_scale_of(env))
     finally:
         env.close()
 
@@ -294,10 +297,10 @@ def train(
     """
     cfg.check()
     extra = {} if extra is None else extra
-    obs_dim, act_dim, low, high = _probe(env_fn, cfg.seed)
+    obs_dim, act_dim, low, high, out_scale = _probe(env_fn, cfg.seed)
     torch.manual_seed(cfg.seed)
     model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high,
-                        cfg.normalize_actions)
+                        cfg.normalize_actions, out_scale)
     pi_opt = _make_optimizer(model.pi.parameters(), cfg.policy_lr, cfg)
     v_opt = _make_optimizer(model.v.parameters(), cfg.value_lr, cfg)
     obs_stats = RunningObsStats(obs_dim, cfg.obs_norm_max_samples)

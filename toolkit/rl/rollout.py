@@ -28,7 +28,7 @@ from typing import Any, Callable, Iterator, Optional, Sequence
 import numpy as np
 import torch
 
-from toolkit.rl.networks import ActorCritic, gaussian_log_prob
+from toolkit.rl.networks import ActorCritic, output_scale_of, gaussian_log_prob
 
 
 def derive_seed(*key: int) -> int:
@@ -93,7 +93,7 @@ class RolloutWorker:
         with torch.random.fork_rng(devices=[]):  # initial weights are overwritten by set_weights
             self.model = ActorCritic(
                 obs_dim, int(np.prod(space.shape)), policy_hidden, value_hidden,
-                space.low, space.high, normalize_actions,
+                space.low, space.high, normalize_actions, output_scale_of(self.envs[0]),
             )
         self.model.eval()
         self.reset_each_collect = bool(reset_each_collect)

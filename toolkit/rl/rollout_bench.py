@@ -202,7 +202,7 @@ def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: in
         largest worker's peak resident memory).
     """
     from toolkit.rl.config import PPOConfig
-    from toolkit.rl.networks import ActorCritic
+    from toolkit.rl.networks import ActorCritic, output_scale_of
     from toolkit.rl.rollout import start_workers
 
     from toolkit.rl.rollout import RolloutWorker
@@ -220,8 +220,10 @@ def collection(env_fn: Callable[[int], Any], n_workers: int, envs_per_worker: in
         probe = env_fn(seed)
         obs_dim, act_dim = int(np.prod(probe.observation_space.shape)), int(np.prod(probe.action_space.shape))
         low, high = probe.action_space.low, probe.action_space.high
+        scale = output_scale_of(probe)
         probe.close()
-        model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions)
+        model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions,
+                            scale)
         workers.call("set_weights", [(model.numpy_state(),)] * workers.size)
         workers.call("collect", [(4, cfg.std_start, 0)] * workers.size)  # warm up
         t0 = time.perf_counter()

@@ -73,6 +73,8 @@ class CharacterEnv(gymnasium.Env):
         self.action_space_ = plugins.load("action", str(action["name"]))(action, "humanoid")
         self.skeleton = self.action_space_.skeleton
         low, high = self.action_space_.bounds()
+        scale = getattr(self.action_space_, "output_scale", None)
+        self.policy_output_scale = scale() if scale is not None else None  # PPO's (toolkit.rl.networks)
         self.action_space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32), dtype=np.float32)
         self.watch = Watch()
         self.done = False
@@ -104,6 +106,10 @@ class CharacterEnv(gymnasium.Env):
         """Substeps of the next control step; None: the simulator's ``sim_hz / control_hz``."""
         return None
 
+    def pd_velocity_targets(self) -> Optional[np.ndarray]:
+        """``qd_target`` ``(n_dof,)`` of the next control step; None: zero target velocities."""
+        return None
+
     # ------------------------------------------------------------------ shared machinery
     def links_and_com(self) -> tuple[np.ndarray, np.ndarray]:
         """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)``."""
@@ -128,7 +134,7 @@ class CharacterEnv(gymnasium.Env):
         if self.done:
             raise RuntimeError("step() after the episode ended; call reset()")
         q_target = self.pd_targets(action)
-        rec = self.sim.step(q_target, n_substeps=self.substeps_now(), watch=self.watch)
+        rec = self.sim.step(q_target, self.pd_velocity_targets(), n_substeps=self.substeps_now(), watch=self.watch)
         reward, terminated, truncated, info = self.finish_step(rec)
         self.done = bool(terminated or truncated)
         obs = self.observe()

@@ -73,3 +73,25 @@ class TestFFCFBC(ActionSpaceContract, FilterOption):
         assert "walk" in str(e.value)
         with pytest.raises(JtError):
             FFCFBCActionSpace({"clip": "laikago_walk"})  # a clip of another character
+
+
+#: LimHigh - LimLow per DoF of the authors' humanoid3d character file, as its JSON lists them
+#: (chest, neck, right hip, knee, ankle, shoulder, elbow, then the left side)
+AUTHORS_A_STD = [2.4] * 3 + [2.0] * 3 + [2.4, 2.0, 4.14] + [3.14] + [2.0, 2.0, 3.14] + [3.64, 3.0, 3.84] + [3.14] \
+    + [2.4, 2.0, 4.14] + [3.14] + [2.0, 2.0, 3.14] + [3.64, 3.0, 3.84] + [3.14]
+
+
+def test_the_output_scale_is_the_authors_joint_range_per_dof():
+    """002 authors' code: the actor's mean offset is a_std * net(s), a_std = LimHigh - LimLow
+    (2-4.14 rad); the correction itself is unscaled (the scale lives in the policy network)."""
+    space = FFCFBCActionSpace({"clip": "walk"})
+    np.testing.assert_allclose(space.output_scale(), AUTHORS_A_STD, atol=1e-12)
+    dq = np.full(28, 0.1)
+    np.testing.assert_allclose(space.targets(dq, 0.25), space.finish(space.reference(0.25) + dq), atol=1e-12)
+    assert FFCFBCActionSpace({"clip": "walk", "output_scale": "none"}).output_scale() is None
+
+
+def test_a_bad_output_scale_is_one_line():
+    with pytest.raises(JtError, match="output_scale") as e:
+        FFCFBCActionSpace({"clip": "walk", "output_scale": "joint"})
+    assert "\n" not in str(e.value)

@@ -67,3 +67,27 @@ def test_gym_check_accepts_pendulum_and_rejects_broken_env():
 
     with pytest.raises(AssertionError):
         check_gym_env(Broken())
+
+
+def test_an_output_scale_multiplies_the_mean_not_the_noise_and_survives_a_checkpoint(tmp_path):
+    """``out_scale`` (an env's ``policy_output_scale``): the policy mean is the MLP's output times
+    the scale; log-densities use the scaled mean with sigma in the env's units; save/load keeps it."""
+    from toolkit.rl import checkpoint as ckpt
+    from toolkit.rl.config import PPOConfig
+
+    torch.manual_seed(0)
+    scale = np.array([1.0, 2.0, 4.0])
+    a = ActorCritic(5, 3, (8,), (8,), -np.ones(3) * 9, np.ones(3) * 9, out_scale=scale)
+    torch.manual_seed(0)
+    b = ActorCritic(5, 3, (8,), (8,), -np.ones(3) * 9, np.ones(3) * 9)
+    obs = torch.randn(4, 5)
+    np.testing.assert_allclose(a.mean_action(obs).detach().numpy(), b.mean_action(obs).detach().numpy() * scale,
+                               rtol=1e-6)
+    mu, _ = a(obs)
+    np.testing.assert_allclose(mu.detach().numpy(), a.mean_action(obs).detach().numpy())
+    path = ckpt.save_training(tmp_path / "ppo.h5", PPOConfig(policy_hidden=(8,), value_hidden=(8,)), a, torch.optim.SGD(a.pi.parameters(), 0.1),
+                              torch.optim.SGD(a.v.parameters(), 0.1), RunningObsStats(5, 10),
+                              np.random.default_rng(0), 1, 10, {}, {}, {}, a.low, a.high)
+    back = ckpt.load_policy(path)
+    np.testing.assert_array_equal(back.out_scale, scale)
+    np.testing.assert_allclose(back.mean_action(obs).detach().numpy(), a.mean_action(obs).detach().numpy(), rtol=1e-6)

@@ -46,7 +46,7 @@ def source(tmp_path_factory):
 def _legacy_warm_start(path, init, cfg, env_fn, extra):
     """Stage 2's former ``write_warm_start``: a fresh-run checkpoint with ``init``'s networks."""
     groups, attrs = ckpt.load(init)
-    obs_dim, act_dim, low, high = ppo._probe(env_fn, cfg.seed)
+    obs_dim, act_dim, low, high, _ = ppo._probe(env_fn, cfg.seed)
     torch.manual_seed(cfg.seed)
     model = ActorCritic(obs_dim, act_dim, cfg.policy_hidden, cfg.value_hidden, low, high, cfg.normalize_actions)
     pi_opt = ppo._make_optimizer(model.pi.parameters(), cfg.policy_lr, cfg)
