@@ -110,7 +110,8 @@ def reference_frames(env: Any, times: np.ndarray, width: int, height: int) -> li
     """The reference of ``env`` (still open) posed at clip times ``env.t0 + times`` and rendered
     ``(height, width, 3)`` with the env's camera, in a second simulator of the env's config (the
     env's own is untouched): kinematically, each pose set by ``Simulator.reset``, nothing
-    stepped. About 6 ms a frame at 120 x 90 on 2 shared cores (4 s for a 20 s rollout)."""
+    stepped; a pose that dips into the ground is shown lifted out of it, as an episode's start is
+    (``SpacetimeEnv``). About 6 ms a frame at 120 x 90 on 2 shared cores (4 s for a 20 s rollout)."""
     from toolkit.render import Camera
 
     from jt_tasks.policy.env import load_simulator
@@ -122,6 +123,11 @@ def reference_frames(env: Any, times: np.ndarray, width: int, height: int) -> li
         for t in np.asarray(times, dtype=float).reshape(-1):
             ref = env.ref.sample(env.t0 + float(t))
             sim.reset(ref.q, ref.qd)
+            low = min(float(sim.aabb(i)[0][1]) for i in range(-1, int(sim.n_links)))
+            if low < 0.0:
+                q = np.array(ref.q, dtype=float)
+                q[1] += float(env.spec_.ground_clearance) - low
+                sim.reset(q, ref.qd)
             out.append(np.asarray(sim.render(int(width), int(height), camera))[..., :3].astype(np.uint8))
     finally:
         sim.close()

@@ -9,7 +9,8 @@ in the authors' order (research notes):
 * 4–17 each link's joint (``chest`` ... ``left_wrist``, PyBullet link order): the angle of the
   local rotation difference (quaternion angle for spherical joints, ``|Δθ|`` for the knees and
   elbows; the wrists are fixed joints, their channel is always 0) (rad);
-* 18–21 ``ee_right_ankle``, ``ee_left_ankle``, ``ee_right_wrist``, ``ee_left_wrist``: distance
+* 18–21 ``ee_right_ankle``, ``ee_right_wrist``, ``ee_left_ankle``, ``ee_left_wrist`` (the authors'
+  bound files' order, so a width table copied from them lands on its channels): distance
   between the end effectors (joint origins) of the two characters, each relative to its own
   ground-projected root in its own heading frame (m).
 
@@ -30,7 +31,7 @@ import numpy as np
 
 COM = ("com_x", "com_y", "com_z")
 ROOT = ("root",)
-END_EFFECTOR_NAMES = ("ee_right_ankle", "ee_left_ankle", "ee_right_wrist", "ee_left_wrist")
+END_EFFECTOR_NAMES = ("ee_right_ankle", "ee_right_wrist", "ee_left_ankle", "ee_left_wrist")
 GROUPS = ("com", "orientation", "end_effector")
 
 

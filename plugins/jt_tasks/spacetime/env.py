@@ -54,7 +54,10 @@ class SpacetimeSpec:
     clip: str = "run"
     heading_axis: str = "x"
     loop: Optional[bool] = None
-    ground_clearance: float = 0.0
+    ground_clearance: float = 0.001  # a penetrating start is lifted to this (authors' code)
+    cycle_turn: bool = True
+    ffc_lead: float = 0.0  # control steps the FFC's phase leads the control step's start
+    ffc_velocity: bool = False  # the reference's joint velocities as the PD target velocity
     termination: str = "bounds"  # bounds | contact
     widths: list = dataclasses.field(default_factory=list)  # (n_channels,), inf = off; [] = 002 §5.1
     width_table: list = dataclasses.field(default_factory=list)  # (K, n_channels) over phase [0, 1]; [] = widths
@@ -81,7 +84,7 @@ class SpacetimeEnv(CharacterEnv):
         from toolkit import plugins
 
         spec = self.spec_
-        self.ref = SpacetimeReference(spec.clip, spec.heading_axis, spec.ground_clearance, spec.loop)
+        self.ref = SpacetimeReference(spec.clip, spec.heading_axis, spec.loop, spec.cycle_turn)
         self.axis = spec.heading_axis
         self.substeps = int(self.sim.n_substeps)
         self.control_hz = self.sim_hz / self.substeps
@@ -113,11 +116,18 @@ class SpacetimeEnv(CharacterEnv):
         self.t0 = self.phase0 * self.ref.period
         ref = self.ref.sample(self.t0)
         if state is None:
-            self.sim.reset(ref.q, ref.qd)
+            q, qd = ref.q, ref.qd
         else:  # an evolved state (002 §4.3.2), root x, z at the reference's (authors' code)
             n_q = len(ref.q)
             q, qd = np.array(state[1:1 + n_q], dtype=float), np.array(state[1 + n_q:], dtype=float)
             q[0], q[2] = ref.q[0], ref.q[2]
+        self.sim.reset(q, qd)
+        low = self.lowest_point()
+        self.start_lift = 0.0
+        if low < 0.0:  # a start that penetrates the ground is lifted (authors' code); others stay
+            self.start_lift = float(spec.ground_clearance) - low
+            q = np.array(q, dtype=float)
+            q[1] += self.start_lift
             self.sim.reset(q, qd)
         if hasattr(self.action_space_, "reset"):
             self.action_space_.reset(ref.phase)
@@ -138,6 +148,10 @@ class SpacetimeEnv(CharacterEnv):
         self._vel_prev = self._qd_prev = None
         if evaluate:
             self._record_body()
+
+    def lowest_point(self) -> float:
+        """M, the lowest point of the character now (its links' bounding boxes)."""
+        return float(min(self.sim.aabb(i)[0][1] for i in range(-1, self.n_links)))
 
     def _record_body(self) -> None:
         """Keep the evaluation's bodies (link CoMs, joint origins) now, for its style measures."""
@@ -214,9 +228,20 @@ class SpacetimeEnv(CharacterEnv):
         return np.concatenate([[phase], q, np.asarray(qd, dtype=float)])
 
     def pd_targets(self, action: np.ndarray) -> np.ndarray:
-        if hasattr(self.action_space_, "set_phase"):  # the FFC's phase: this control step's
-            self.action_space_.set_phase(self.ref.phase(self.clip_time))
+        if hasattr(self.action_space_, "set_phase"):  # the FFC's phase: this control step's (+ the lead)
+            lead = float(self.spec_.ffc_lead) / self.control_hz
+            self.action_space_.set_phase(self.ref.phase(self.clip_time + lead))
         return super().pd_targets(action)
+
+    def pd_velocity_targets(self) -> Optional[np.ndarray]:
+        """With ``ffc_velocity``: the reference's joint velocities ``(n_dof,)`` at the FFC's time
+        (root entries 0), the PD target velocity; else None (zero target velocity, 002 / authors)."""
+        if not self.spec_.ffc_velocity:
+            return None
+        lead = float(self.spec_.ffc_lead) / self.control_hz
+        qd = np.array(self.ref.sample(self.clip_time + lead).qd, dtype=float)
+        qd[:6] = 0.0
+        return qd
 
     def observe(self) -> np.ndarray:
         from jt_tasks.spacetime import kernels

@@ -46,27 +46,44 @@ def _rotate(x: float, y: float, z: float, w: float, vx: float, vy: float, vz: fl
 
 
 @njit(cache=True)
-def sample(i: int, f: float, k: int, held: bool, lift: float, root_pos: np.ndarray, joints: np.ndarray,
-           vel: np.ndarray, com: np.ndarray, ee: np.ndarray, offset: np.ndarray, q0: np.ndarray,
-           log: np.ndarray, sph: np.ndarray, q_out: np.ndarray, qd_out: np.ndarray, com_out: np.ndarray,
-           ee_out: np.ndarray) -> None:
-    """The reference between frames ``i`` and ``i + 1`` at fraction ``f`` of cycle ``k``.
+def sample(i: int, f: float, held: bool, cos_a: float, sin_a: float, p0: np.ndarray, origin: np.ndarray,
+           root_pos: np.ndarray, joints: np.ndarray, vel: np.ndarray, com: np.ndarray, ee: np.ndarray,
+           q0: np.ndarray, log: np.ndarray, sph: np.ndarray, q_out: np.ndarray, qd_out: np.ndarray,
+           com_out: np.ndarray, ee_out: np.ndarray) -> None:
+    """The reference between frames ``i`` and ``i + 1`` at fraction ``f``, moved into its cycle.
+
+    The cycle's ground-plane motion (``SpacetimeReference``): horizontal positions ``x`` become
+    ``R (x - p0) + origin``, the root rotation ``R q`` and the root velocities ``R v``, with ``R``
+    the turn about +y of cosine ``cos_a`` and sine ``sin_a`` (1, 0 in the first cycle: positions
+    only shifted by ``origin - p0``); joints and the heading-frame end effectors are unchanged.
 
     Args:
+        p0: the first frame's root on the ground plane ``(3,)``; origin: its place in this cycle.
         root_pos: ``(n_frames, 3)``; joints: ``(n_frames, n_joint_q)``; vel: ``(n_frames, n_dof)``;
-            com: ``(n_frames, 3)`` (lifted); ee: ``(n_frames, 4, 3)`` (lifted); offset: ``(3,)`` per cycle.
+            com: ``(n_frames, 3)``; ee: ``(n_frames, 4, 3)`` (heading frame).
         q0, log: the slerp tables ``(n_frames - 1, 1 + n_spherical, 4)`` / ``(..., 3)`` (root first).
         sph: ``(n_spherical, 4)`` quaternion columns of the spherical joints in ``joints``.
         q_out: ``(3 + 4 + n_joint_q,)``; qd_out: ``(n_dof,)``; com_out: ``(3,)``; ee_out: ``(4, 3)``.
     """
     g = 1 - f
-    for d in range(3):
-        extra = lift if d == 1 else 0.0
-        q_out[d] = g * root_pos[i, d] + f * root_pos[i + 1, d] + k * offset[d] + extra
-        com_out[d] = g * com[i, d] + f * com[i + 1, d] + k * offset[d]
+    px = g * root_pos[i, 0] + f * root_pos[i + 1, 0] - p0[0]
+    pz = g * root_pos[i, 2] + f * root_pos[i + 1, 2] - p0[2]
+    q_out[0] = cos_a * px + sin_a * pz + origin[0]
+    q_out[1] = g * root_pos[i, 1] + f * root_pos[i + 1, 1]
+    q_out[2] = -sin_a * px + cos_a * pz + origin[2]
+    cx = g * com[i, 0] + f * com[i + 1, 0] - p0[0]
+    cz = g * com[i, 2] + f * com[i + 1, 2] - p0[2]
+    com_out[0] = cos_a * cx + sin_a * cz + origin[0]
+    com_out[1] = g * com[i, 1] + f * com[i + 1, 1]
+    com_out[2] = -sin_a * cx + cos_a * cz + origin[2]
     nj = joints.shape[1]
     for j in range(nj):
         q_out[7 + j] = g * joints[i, j] + f * joints[i + 1, j]
+    # the turn's half-angle quaternion (0, sh, 0, ch) from cos / sin of the angle
+    ch = math.sqrt(max(0.5 * (1.0 + cos_a), 0.0))
+    sh = 0.0 if ch == 0.0 else 0.5 * sin_a / ch
+    if ch == 0.0:
+        sh = 1.0
     for r in range(q0.shape[1]):
         v0, v1, v2 = log[i, r, 0] * f, log[i, r, 1] * f, log[i, r, 2] * f
         theta = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
@@ -87,12 +104,18 @@ def sample(i: int, f: float, k: int, held: bool, lift: float, root_pos: np.ndarr
         else:
             x, y, z, w = 0.0, 0.0, 0.0, 1.0
         if r == 0:
+            if sin_a != 0.0:  # (0, sh, 0, ch) * (x, y, z, w)
+                x, y, z, w = ch * x + sh * z, ch * y + sh * w, ch * z - sh * x, ch * w - sh * y
             q_out[3], q_out[4], q_out[5], q_out[6] = x, y, z, w
         else:
             c = sph[r - 1]
             q_out[7 + c[0]], q_out[7 + c[1]], q_out[7 + c[2]], q_out[7 + c[3]] = x, y, z, w
     for j in range(qd_out.shape[0]):
         qd_out[j] = 0.0 if held else g * vel[i, j] + f * vel[i + 1, j]
+    if sin_a != 0.0:
+        for b in range(2):
+            vx, vz = qd_out[3 * b], qd_out[3 * b + 2]
+            qd_out[3 * b], qd_out[3 * b + 2] = cos_a * vx + sin_a * vz, -sin_a * vx + cos_a * vz
     for e in range(4):
         for d in range(3):
             ee_out[e, d] = g * ee[i, e, d] + f * ee[i + 1, e, d]

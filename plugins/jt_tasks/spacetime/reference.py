@@ -10,14 +10,21 @@ answers, at any clip time ``t`` (``sample``) or phase (``at_phase``):
 * the whole-body CoM (world) and the four end effectors (ankle and wrist joint origins, relative
   to the ground-projected root, in the root's heading frame), per frame by PyBullet forward
   kinematics in ``toolkit.motion`` (never imported here), interpolated linearly;
-* a looping clip repeats with the root shifted by ``Clip.cycle_offset()`` (vertical part zeroed)
-  per cycle; a non-looping clip holds its last frame (zero velocities) after its end.
+* a looping clip repeats cycle after cycle. With ``cycle_turn`` (default) cycle ``k`` is the clip
+  moved by the ``k``-th power of the rigid ground-plane motion ``T`` that takes the first frame's
+  root onto the last frame's (its yaw ``turn`` about +y and its shift): ``T(x) = R(turn) (x - p_0)
+  + p_N`` on horizontal positions, ``R(turn)`` on the root rotation and the root velocities, so a
+  character that tracks the clip's own steps keeps following its reference across the seam
+  (the walk turns 0.12 rad per cycle, the run 0.09). Without it (the authors' code), each cycle
+  is shifted by ``Clip.cycle_offset()`` only and the heading snaps back at every seam. A
+  non-looping clip holds its last frame (zero velocities) after its end.
 
 The heading frame turns about +y (y-up world): ``heading_axis`` x (the humanoid's forward axis)
 or z (backflip, roll, crawl: x points up or down during the motion; authors' code).
 
-The clip's feet dip a few cm into the ground in places: the whole reference is lifted by
-``lift`` so that its lowest point over the clip is ``ground_clearance`` above the ground (ours).
+The reference is the clip as recorded: no lift (its feet dip a few cm into the ground in some
+frames: 6.8 cm in one frame of the run). An episode's *start* is lifted only when it penetrates
+the ground (``SpacetimeEnv``), as in the authors' code.
 """
 
 from __future__ import annotations
@@ -32,8 +39,9 @@ import numpy as np
 
 from toolkit.motion import rotations as rot
 
-#: end-effector links (PyBullet link index = joint index): right ankle, left ankle, right wrist, left wrist
-END_EFFECTORS = (5, 11, 8, 14)
+#: end-effector links (PyBullet link index = joint index) in the authors' bound-file order: right
+#: ankle, right wrist, left ankle, left wrist (their data/bounds readme, channels 18-21)
+END_EFFECTORS = (5, 8, 11, 14)
 HEADING_AXES = {"x": np.array([1.0, 0.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
 
 
@@ -121,12 +129,17 @@ class SpacetimeReference:
     Args:
         clip: a ``pybullet_data`` humanoid clip name or a path.
         heading_axis: ``x`` or ``z``.
-        ground_clearance: m, the lowest point of the clip after the lift (ours).
         loop: override the clip's own ``Loop`` flag (None: keep it; every shipped clip wraps).
+        cycle_turn: carry the clip's heading change per cycle into the next cycles (module docstring).
+
+    Attributes:
+        turn: rad, the heading change over one cycle (last frame minus first; 0 for a non-looping
+            clip or without ``cycle_turn``).
+        lowest: m, ``(n_frames,)`` the lowest point of each frame's pose (link bounding boxes).
     """
 
-    def __init__(self, clip: str = "run", heading_axis: str = "x", ground_clearance: float = 0.0,
-                 loop: Optional[bool] = None) -> None:
+    def __init__(self, clip: str = "run", heading_axis: str = "x", loop: Optional[bool] = None,
+                 cycle_turn: bool = True) -> None:
         from toolkit.errors import JtError
         from toolkit.motion.kinematics import KinematicBody, clip_velocities, forward_kinematics
 
@@ -147,20 +160,49 @@ class SpacetimeReference:
         body = KinematicBody(c.skeleton)
         try:
             self.masses = np.asarray(body.masses, dtype=float)
-            low = min(body.lowest_point(np.concatenate([c.root_pos[i], c.root_rot[i], c.joints[i]]))
-                      for i in range(c.n_frames))
+            self.lowest = np.array([body.lowest_point(np.concatenate([c.root_pos[i], c.root_rot[i], c.joints[i]]))
+                                    for i in range(c.n_frames)])
         finally:
             body.close()
-        self.lift = float(ground_clearance - low)
         m = self.masses
         self._com = (m[0] * c.root_pos + np.einsum("l,fld->fd", m[1:], kin.link_com)) / m.sum()
-        self._com[:, 1] += self.lift
         self._ee = np.stack([heading_frame(np.concatenate([c.root_pos[i], c.root_rot[i]]),
                                            kin.joint_pos[i, list(END_EFFECTORS)], heading_axis)
                              for i in range(c.n_frames)])
-        self._ee[:, :, 1] += self.lift
         self._times = [float(x) for x in c.times]
+        self.turn = 0.0
+        if self.loop and cycle_turn:
+            yaw = [2.0 * math.atan2(heading_quat(c.root_rot[i], heading_axis)[1],
+                                    heading_quat(c.root_rot[i], heading_axis)[3]) for i in (0, -1)]
+            self.turn = float(math.remainder(yaw[1] - yaw[0], 2.0 * math.pi))
+        self._p0 = np.array([c.root_pos[0, 0], 0.0, c.root_pos[0, 2]])
+        self._cycles: dict[int, np.ndarray] = {0: self._p0.copy()}
+        if self.turn != 0.0:
+            self._seam_velocities()
         self._slerp_tables()
+
+    def _turned(self, k: int, pos: np.ndarray, quat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A first-cycle root position ``(3,)`` and rotation ``(4,)`` moved into cycle ``k``."""
+        a = k * self.turn
+        d = pos - self._p0
+        o = self.cycle_origin(k)
+        p = np.array([math.cos(a) * d[0] + math.sin(a) * d[2] + o[0], pos[1],
+                      -math.sin(a) * d[0] + math.cos(a) * d[2] + o[2]])
+        yaw = np.array([0.0, math.sin(0.5 * a), 0.0, math.cos(0.5 * a)])
+        return p, rot.quat_multiply(yaw, quat)
+
+    def _seam_velocities(self) -> None:
+        """The root velocities of the first and last frame from their neighbours in the turned
+        previous / next cycle (``clip_velocities`` takes them from a shifted, unturned one)."""
+        c, t = self.clip, self.clip.times
+        p_prev, r_prev = self._turned(-1, c.root_pos[-2], c.root_rot[-2])
+        p_next, r_next = self._turned(1, c.root_pos[1], c.root_rot[1])
+        for row, (pa, ra, pb, rb, dt) in enumerate([
+                (p_prev, r_prev, c.root_pos[1], c.root_rot[1], t[1] + (t[-1] - t[-2])),
+                (c.root_pos[-2], c.root_rot[-2], p_next, r_next, (t[-1] + t[1] - t[0]) - t[-2])]):
+            i = 0 if row == 0 else -1
+            self._vel[i, :3] = (pb - pa) / dt
+            self._vel[i, 3:6] = rot.quat_to_expmap(rot.quat_multiply(rb, rot.quat_conjugate(ra))) / dt
 
     def _slerp_tables(self) -> None:
         """Per frame pair ``i``, what ``quat_slerp`` computes before the fraction enters: the start
@@ -178,7 +220,27 @@ class SpacetimeReference:
             logs.append(rot.quat_to_expmap(rot.quat_canonical(rot.quat_relative(q0, q1))))
         self._slerp_q0, self._slerp_log = np.array(q0s), np.array(logs)
         self.offset = np.ascontiguousarray(self.offset, dtype=float)
-        self._lift_vec = np.array([0.0, self.lift, 0.0])
+
+    def cycle_origin(self, k: int) -> np.ndarray:
+        """Where cycle ``k`` puts the first frame's root on the ground plane ``(3,)`` (y = 0):
+        ``T^k(p_0)``; with no turn ``p_0 + k offset``."""
+        k = int(k)
+        got = self._cycles.get(k)
+        if got is not None:
+            return got
+        step = 1 if k > 0 else -1
+        j = 0
+        while j + step in self._cycles:
+            j += step
+        c = self._cycles[j]
+        while j != k:  # c_{j+1} = c_j + R(j turn) offset; c_{j-1} = c_j - R((j-1) turn) offset
+            a = (j if step > 0 else j - 1) * self.turn
+            off = np.array([math.cos(a) * self.offset[0] + math.sin(a) * self.offset[2], 0.0,
+                            -math.sin(a) * self.offset[0] + math.cos(a) * self.offset[2]])
+            c = c + step * off
+            j += step
+            self._cycles[j] = c
+        return c
 
     # ------------------------------------------------------------------ time
     def phase(self, t: float) -> float:
@@ -213,8 +275,9 @@ class SpacetimeReference:
         c = self.clip
         q, qd = np.empty(7 + c.joints.shape[1]), np.empty(self._vel.shape[1])
         com, ee = np.empty(3), np.empty((4, 3))
-        kernels.sample(i, f, k, held, self.lift, c.root_pos, c.joints, self._vel, self._com, self._ee,
-                       self.offset, self._slerp_q0, self._slerp_log, self._sph, q, qd, com, ee)
+        a = k * self.turn
+        kernels.sample(i, f, held, math.cos(a), math.sin(a), self._p0, self.cycle_origin(k), c.root_pos, c.joints,
+                       self._vel, self._com, self._ee, self._slerp_q0, self._slerp_log, self._sph, q, qd, com, ee)
         return RefState(q, qd, com, ee, self.phase(t))
 
     def at_phase(self, phase: float, cycle: int = 0) -> RefState:

@@ -90,8 +90,16 @@ class SpacetimeConfig(PolicyConfig):
     """S, a non-looping clip is extended by holding its last frame this long (authors' code)."""
     init_phase: Optional[float] = None
     """Start phase of training episodes; null: uniform over [0, 1) (reference state initialisation, 002 §4.2 / DeepMimic)."""
-    ground_clearance: float = 0.0
-    """M, the reference is lifted so that its lowest point over the clip is this high (ours: the clips dip into the ground)."""
+    ground_clearance: float = 0.001
+    """M, a start that penetrates the ground is lifted so that its lowest point is this high; other starts and the reference are the clip's own (authors' code: 0.001)."""
+    cycle_turn: bool = True
+    """A looping clip's next cycle carries on its heading change (the walk turns 0.12 rad per cycle), so the reference is where a character tracking the clip goes (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam)."""
+    ffc_lead: float = 0.0
+    """Control steps by which the FFC's reference pose leads the control step's start (002 and the authors' code: 0, the pose at the start of the step held over its substeps)."""
+    ffc_velocity: bool = False
+    """The reference's joint velocities at the FFC's time as the PD target velocity (002 and the authors' code: zero target velocity)."""
+    eval_starts: int = 4
+    """Start phases of Table 1's evaluation, eval_phase + k / eval_starts; survival_s is their mean, survival_min_s the worst (authors' code: the mean over several episodes from random phases; ours: evenly spread, deterministic)."""
     style: list = dataclasses.field(default_factory=list)
     """Style reward terms ([{name: energy, ...}], jt.rewards), multiplied into the reward of 1 (002 §3.3 eqs 4-8)."""
     eval_phase: float = 0.0
@@ -162,7 +170,11 @@ class SpacetimeConfig(PolicyConfig):
         for key in ("init_phase", "eval_phase"):
             v = getattr(self, key)
             require(v is None or (finite(v) and 0.0 <= v <= 1.0), f"task.{key}", v, "a phase in [0, 1]")
-        require(finite(self.ground_clearance), "task.ground_clearance", self.ground_clearance, "a finite number (m)")
+        require(finite(self.ground_clearance) and self.ground_clearance >= 0, "task.ground_clearance",
+                self.ground_clearance, "a finite number >= 0 (m)")
+        require(finite(self.ffc_lead) and self.ffc_lead >= 0, "task.ffc_lead", self.ffc_lead,
+                "a number of control steps >= 0")
+        require(int(self.eval_starts) >= 1, "task.eval_starts", self.eval_starts, "an integer >= 1")
         if self.allowed_contacts is not None:
             known = {"base", "all", *HUMANOID.links}
             bad = [n for n in self.allowed_contacts if str(n) not in known]
@@ -223,7 +235,8 @@ class SpacetimeTask(PolicyTask):
         clip = Path(str(p.clip)).stem.replace("humanoid3d_", "")
         allowed = allowed_links(HUMANOID, clip, None if p.allowed_contacts is None else list(p.allowed_contacts))
         return SpacetimeSpec(clip=str(p.clip), heading_axis=self.heading_axis(), loop=p.loop,
-                             ground_clearance=float(p.ground_clearance), termination=p.termination,
+                             ground_clearance=float(p.ground_clearance), cycle_turn=bool(p.cycle_turn),
+                             ffc_lead=float(p.ffc_lead), ffc_velocity=bool(p.ffc_velocity), termination=p.termination,
                              widths=[float(x) for x in w],
                              width_table=bd.width_table(HUMANOID, w, p.width_table).tolist(), time_limit=float(p.time_limit), hold_s=float(p.hold_s),
                              init_phase=p.init_phase, train_allowed=allowed, eval_allowed=allowed,
@@ -246,7 +259,8 @@ class SpacetimeTask(PolicyTask):
         sampler = StartSampler(params, extra, ctx.seed) if (params.importance or params.evolution) else None
         total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
         hook = SpacetimeTraining(sampler, functools.partial(self.env_class, spec, seed=ctx.seed),
-                                 self.final_options(None), int(self.params.eval_every), extra, ctx.progress, total)
+                                 self.final_options(None), int(self.params.eval_every), extra, ctx.progress, total,
+                                 int(self.params.eval_starts))
         return Hooks(on_iteration=hook, extra=extra, state={"sampler": sampler, "training": hook})
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
@@ -308,11 +322,16 @@ class SpacetimeTask(PolicyTask):
 
             write_motion_vs_reference(workdir, ro["frames"], ro["reference_frames"], ro["fps"])
         hook = hooks.state.get("training")
-        rows = hook.history() if hook is not None else np.zeros((0, 3))
+        if hook is not None and hook.n_starts > 1:  # the final policy from every start phase
+            mean, share, worst = hook.evaluate(trained.result.model)
+            metrics.update({"survival_first_s": survival, "survival_s": mean, "survival_min_s": worst,
+                            "survived": share})
+        rows = hook.history() if hook is not None else np.zeros((0, 4))
         if len(rows):
             from jt_tasks.spacetime.training import samples_to_20s
 
             history["survival_s"] = [(int(r[0]), float(r[1])) for r in rows]
+            history["survival_min_s"] = [(int(r[0]), float(r[3])) for r in rows]
             reached = samples_to_20s(rows)
             if reached is not None:
                 metrics["samples_to_20s"] = reached

@@ -25,6 +25,25 @@ def state(ref, t):
     return bd.BodyState(r.q.copy(), r.com.copy(), r.ee.copy())
 
 
+#: the channels of the authors' bound files, as their data/bounds readme lists them (0-21)
+AUTHORS_CHANNELS = (
+    "CoM x", "CoM y", "CoM z", "root", "chest", "neck", "right_hip", "right_knee", "right_ankle",
+    "right_shoulder", "right_elbow", "right_wrist", "left_hip", "left_knee", "left_ankle", "left_shoulder",
+    "left_elbow", "left_wrist", "right_ankle pos", "right_wrist pos", "left_ankle pos", "left_wrist pos")
+
+
+def test_channels_are_in_the_order_of_the_authors_bound_files():
+    """A width table copied from the authors' files lands on its channels (issue: the end
+    effectors were right ankle, left ankle, right wrist, left wrist)."""
+    ours = [n.replace("com_", "CoM ").replace("CoM x", "CoM x") for n in NAMES]
+    ours = [f"{n[3:]} pos" if n.startswith("ee_") else n for n in ours]
+    assert tuple(ours) == AUTHORS_CHANNELS
+    from toolkit.motion.skeletons import HUMANOID as H
+
+    links = ["base"] + list(H.links)
+    assert [links[i + 1] for i in END_EFFECTORS] == ["right_ankle", "right_wrist", "left_ankle", "left_wrist"]
+
+
 def test_22_channels_in_the_authors_order_with_the_paper_widths():
     assert len(NAMES) == 22
     assert NAMES[:4] == ("com_x", "com_y", "com_z", "root")

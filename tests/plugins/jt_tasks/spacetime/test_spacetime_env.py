@@ -146,7 +146,6 @@ def test_a_phase_table_bounds_each_phase_by_its_own_row():
     """A table that is tight (CoM 1 mm) over phases 0-0.2 and loose (10 m) from 0.25 on: an
     episode started in the loose part survives to its time limit, one started in the tight part
     is out of bounds at once."""
-    import math
 
     loose = [10.0] * 22
     tight = dict(zip(("com_x", "com_y", "com_z"), (1e-3,) * 3))
@@ -173,3 +172,75 @@ def test_a_phase_table_bounds_each_phase_by_its_own_row():
         assert why.startswith("out of bounds: com_") and n_tight < n_off and why_off == "time limit"
     finally:
         e.close()
+
+
+@pytest.mark.parametrize("clip", ["run", "roll"])
+def test_a_start_is_the_clips_own_pose_lifted_only_when_it_penetrates(clip):
+    """Over 20 start phases: the start's lowest point is within 1 cm of the clip's own at that
+    pose (no global lift), never below the ground, and in the run's flight phase it is airborne;
+    the median clearance is ≤ 2 cm (issue: 7.0 cm on run, 7.9 on roll with the global lift)."""
+    from toolkit.motion.kinematics import KinematicBody
+
+    e = make_env(seed=0, clip=clip)
+    body = KinematicBody(e.skeleton)
+    lows = []
+    try:
+        for k in range(20):
+            e.reset(options={"phase": k / 20})
+            low = e.lowest_point()
+            own = body.lowest_point(e.ref.at_phase(k / 20).q)
+            assert low >= 0.0
+            assert low == pytest.approx(max(own, e.spec_.ground_clearance), abs=0.01)
+            if own >= 0.0:
+                assert e.start_lift == 0.0
+            lows.append(low)
+    finally:
+        body.close()
+        e.close()
+    assert np.median(lows) <= 0.02
+    if clip == "run":
+        assert max(lows) > 0.05  # a flight phase starts in the air
+
+
+def _zero_steps(**kw) -> float:
+    e = make_env(seed=0, clip="walk", **kw)
+    steps = []
+    try:
+        for k in range(8):
+            e.reset(options={"phase": k / 8})
+            done, n = False, 0
+            while not done and n < 300:
+                _, _, te, tr, _ = e.step(np.zeros(e.action_space.shape, np.float32))
+                done, n = te or tr, n + 1
+            steps.append(n)
+    finally:
+        e.close()
+    return float(np.mean(steps))
+
+
+def test_the_ffc_lead_and_target_velocity_keep_the_uncorrected_ffc_inside_the_bounds_longer():
+    """Zero-correction rollouts on walk from 8 phases: the one-step lead and the reference's
+    target velocity each stay inside the bounds longer than the paper's FFC (issue: 11 steps)."""
+    paper = _zero_steps()
+    assert _zero_steps(ffc_lead=1.0) > paper
+    assert _zero_steps(ffc_velocity=True) > paper
+    assert _zero_steps(ffc_lead=1.0, ffc_velocity=True) > paper + 4
+
+
+def test_the_ffc_target_velocity_is_the_references_joint_velocity_at_the_ffcs_time():
+    e = make_env(seed=0, ffc_velocity=True, ffc_lead=1.0)
+    try:
+        e.reset(options={"phase": 0.25})
+        qd = e.pd_velocity_targets()
+        ref = e.ref.sample(e.clip_time + 1.0 / e.control_hz)
+        np.testing.assert_array_equal(qd[:6], 0.0)
+        np.testing.assert_allclose(qd[6:], ref.qd[6:], atol=1e-12)
+        e.pd_targets(np.zeros(e.action_space.shape, np.float32))
+        assert e.action_space_.phase == pytest.approx(e.ref.phase(e.clip_time + 1.0 / e.control_hz))
+    finally:
+        e.close()
+    plain = make_env(seed=0)
+    try:
+        assert plain.pd_velocity_targets() is None
+    finally:
+        plain.close()

@@ -1,4 +1,5 @@
-"""The reference motion: any clip, any phase, per-cycle root offset, seam-free velocities, hold."""
+"""The reference motion: any clip, any phase, the clip's own heights, cycles that carry on the
+clip's turn, seam-free velocities, hold."""
 
 from __future__ import annotations
 
@@ -26,24 +27,94 @@ def test_every_shipped_humanoid_clip_loads_and_samples():
             assert np.all(np.isfinite(s.q)) and np.all(np.isfinite(s.qd))
 
 
-def test_frames_are_the_clips_own_poses_lifted(run):
+def test_frames_are_the_clips_own_poses_at_the_clips_own_height(run):
+    """No global lift (issue: the run's one frame at -6.8 cm lifted every frame by it)."""
     c = run.clip
     for i in (0, 7, c.n_frames - 2):
         s = run.sample(c.times[i])
-        np.testing.assert_allclose(s.q[:3], c.root_pos[i] + [0, run.lift, 0], atol=1e-9)
+        np.testing.assert_allclose(s.q[:3], c.root_pos[i], atol=1e-9)
         assert rot.quat_angle(s.q[3:7], c.root_rot[i]) < 1e-6
+    assert run.lowest.min() < -0.06 and np.median(run.lowest) > -0.01  # the clip's own dip is kept
 
 
-def test_each_cycle_shifts_the_root_by_the_offset_with_no_vertical_part(run):
-    assert run.offset[1] == 0.0 and abs(run.offset[0]) > 1.0
+def _yaw(q):
+    h = heading_quat(q)
+    return 2.0 * np.arctan2(h[1], h[3])
+
+
+def test_without_the_turn_each_cycle_shifts_the_root_by_the_offset_with_no_vertical_part():
+    r = SpacetimeReference("run", cycle_turn=False)
+    assert r.turn == 0.0 and r.offset[1] == 0.0 and abs(r.offset[0]) > 1.0
     for phase in (0.1, 0.6):
-        a, b = run.at_phase(phase, 0), run.at_phase(phase, 3)
-        np.testing.assert_allclose(b.q[:3] - a.q[:3], 3 * run.offset, atol=1e-9)
-        np.testing.assert_allclose(b.com - a.com, 3 * run.offset, atol=1e-9)
+        a, b = r.at_phase(phase, 0), r.at_phase(phase, 3)
+        np.testing.assert_allclose(b.q[:3] - a.q[:3], 3 * r.offset, atol=1e-9)
+        np.testing.assert_allclose(b.com - a.com, 3 * r.offset, atol=1e-9)
         np.testing.assert_allclose(b.q[3:], a.q[3:], atol=1e-9)
         np.testing.assert_allclose(b.qd, a.qd, atol=1e-9)
         np.testing.assert_allclose(b.ee, a.ee, atol=1e-9)
         assert a.phase == pytest.approx(phase) and b.phase == pytest.approx(phase)
+
+
+@pytest.mark.parametrize("clip, turn", [("walk", 0.12), ("run", -0.09)])
+def test_each_cycle_is_the_first_moved_by_the_clips_own_turn(clip, turn):
+    """Cycle k = the first cycle under the k-th power of the rigid motion taking the first frame's
+    root onto the last frame's: the heading advances by ``turn`` per cycle, positions turn about
+    the cycle's start, joints, heights and heading-frame end effectors are the first cycle's."""
+    r = SpacetimeReference(clip)
+    assert r.turn == pytest.approx(turn, abs=0.01)
+    c = r.clip
+    assert float(np.remainder(_yaw(c.root_rot[-1]) - _yaw(c.root_rot[0]) - r.turn + np.pi, 2 * np.pi) - np.pi) \
+        == pytest.approx(0.0, abs=1e-12)
+    for k in (-2, 1, 3):
+        for phase in (0.1, 0.6):
+            a, b = r.at_phase(phase, 0), r.at_phase(phase, k)
+            ang = k * r.turn
+            R = np.array([[np.cos(ang), 0, np.sin(ang)], [0, 1, 0], [-np.sin(ang), 0, np.cos(ang)]])
+            p0 = np.array([c.root_pos[0, 0], 0.0, c.root_pos[0, 2]])
+            np.testing.assert_allclose(b.q[:3], R @ (a.q[:3] - p0) + r.cycle_origin(k), atol=1e-9)
+            np.testing.assert_allclose(b.com, R @ (a.com - p0) + r.cycle_origin(k), atol=1e-9)
+            assert np.remainder(_yaw(b.q[3:7]) - _yaw(a.q[3:7]) - ang + np.pi, 2 * np.pi) - np.pi \
+                == pytest.approx(0.0, abs=1e-9)
+            np.testing.assert_allclose(b.q[7:], a.q[7:], atol=1e-12)
+            np.testing.assert_allclose(b.qd[:3], R @ a.qd[:3], atol=1e-9)
+            np.testing.assert_allclose(b.qd[3:6], R @ a.qd[3:6], atol=1e-9)
+            np.testing.assert_allclose(b.qd[6:], a.qd[6:], atol=1e-12)
+            np.testing.assert_allclose(b.ee, a.ee, atol=1e-12)
+    np.testing.assert_allclose(r.cycle_origin(1), p0 + r.offset, atol=1e-12)  # T(p0) = p_N
+
+
+def test_a_tracking_characters_path_stays_inside_the_com_bounds_for_20_s():
+    """Outside reference: a character that tracks the walk's steps exactly, integrated from the
+    clip's own heading-frame root steps and turns at 600 Hz (across a seam the step of the turned reference, as the data jumps there), stays
+    within the 0.2 m CoM bounds of the reference over 20 s; the authors' shifted-only cycles leave
+    them within the 20 s (the heading snaps back at every seam)."""
+    r, flat = SpacetimeReference("walk"), SpacetimeReference("walk", cycle_turn=False)
+    dt, n = 1.0 / 600.0, 12000
+    s0 = r.sample(0.0)
+    pos, yaw = np.array([s0.q[0], 0.0, s0.q[2]]), _yaw(s0.q[3:7])
+    worst, worst_flat = 0.0, 0.0
+    for i in range(n):
+        t = i * dt
+        a, b = r.sample(t), r.sample(t + dt)  # the clip's local step: heading-frame displacement and turn
+        la, lb = flat.sample(t % r.period), flat.sample((t % r.period) + dt)
+        d = lb.q[:3] - la.q[:3]
+        ya = _yaw(la.q[3:7])
+        local = np.array([np.cos(ya) * d[0] - np.sin(ya) * d[2], 0.0, np.sin(ya) * d[0] + np.cos(ya) * d[2]])
+        dyaw = np.remainder(_yaw(lb.q[3:7]) - ya + np.pi, 2 * np.pi) - np.pi
+        if (t % r.period) + dt > r.period:  # across the seam the clip's data jumps: take the turned reference's step
+            d = b.q[:3] - a.q[:3]
+            yb = _yaw(a.q[3:7])
+            local = np.array([np.cos(yb) * d[0] - np.sin(yb) * d[2], 0.0, np.sin(yb) * d[0] + np.cos(yb) * d[2]])
+            dyaw = np.remainder(_yaw(b.q[3:7]) - yb + np.pi, 2 * np.pi) - np.pi
+        pos = pos + np.array([np.cos(yaw) * local[0] + np.sin(yaw) * local[2], 0.0,
+                              -np.sin(yaw) * local[0] + np.cos(yaw) * local[2]])
+        yaw += dyaw
+        if i % 20 == 19:
+            worst = max(worst, float(np.hypot(*(pos - r.sample(t + dt).q[:3])[[0, 2]])))
+            worst_flat = max(worst_flat, float(np.hypot(*(pos - flat.sample(t + dt).q[:3])[[0, 2]])))
+    print(f"tracking vs turned reference {worst:.3f} m, vs shifted-only {worst_flat:.3f} m")
+    assert worst < 0.05
+    assert worst_flat > 0.2
 
 
 def test_velocities_have_no_spike_at_the_loop_seam(run):

@@ -211,12 +211,38 @@ def test_evaluation_during_training_ends_on_the_final_policys_survival(tmp_path)
     curve = ev.history["survival_s"]
     assert [s for s, _ in curve] == [64, 128, 192]  # after every iteration
     assert all(0 < v <= 1.0 for _, v in curve)  # smoke: a 1 s evaluation
-    assert curve[-1][1] == pytest.approx(ev.metrics["survival_s"])  # same policy, same deterministic start
+    assert curve[-1][1] == pytest.approx(ev.metrics["survival_s"])  # same policy, the same 4 deterministic starts
+    worst = ev.history["survival_min_s"]
+    assert [s for s, _ in worst] == [64, 128, 192] and all(w <= v + 1e-12 for (_, w), (_, v) in zip(worst, curve))
+    assert ev.metrics["survival_min_s"] <= ev.metrics["survival_s"] <= 1.0
+    assert "survival_first_s" in ev.metrics  # the final rollout's own episode (from eval_phase)
     assert "samples_to_20s" not in ev.metrics  # never survived
 
 
-def test_samples_to_20s_is_the_first_surviving_evaluation():
+def test_the_evaluation_starts_from_evenly_spread_phases_and_reports_mean_and_min():
+    from jt_tasks.spacetime.training import SpacetimeTraining
+
+    from spacetime_helpers import make_env
+
+    class Still:  # a policy of zero corrections: the FFC alone
+        def act(self, obs):
+            return np.zeros(28)
+
+    hook = SpacetimeTraining(None, lambda: make_env(seed=0, clip="walk", eval_time_limit=2.0),
+                             {"phase": 0.1, "evaluate": True}, 1, {}, n_starts=4)
+    assert hook.phases() == pytest.approx([0.1, 0.35, 0.6, 0.85])
+    mean, share, worst = hook.evaluate(Still())
+    singles = []
+    for phase in hook.phases():
+        one = SpacetimeTraining(None, lambda: make_env(seed=0, clip="walk", eval_time_limit=2.0),
+                                {"phase": phase, "evaluate": True}, 1, {}, n_starts=1)
+        singles.append(one.evaluate(Still())[0])
+    assert mean == pytest.approx(np.mean(singles)) and worst == pytest.approx(min(singles))
+    assert 0.0 <= share <= 1.0 and worst < 2.0
+
+
+def test_samples_to_20s_is_the_first_evaluation_where_every_start_survived():
     from jt_tasks.spacetime.training import samples_to_20s
 
-    rows = np.array([[4096, 3.0, 0], [8192, 20.0, 1], [12288, 7.0, 0], [16384, 20.0, 1]])
-    assert samples_to_20s(rows) == 8192 and samples_to_20s(rows[[0, 2]]) is None
+    rows = np.array([[4096, 3.0, 0, 1.0], [8192, 15.0, 0.75, 0.2], [12288, 20.0, 1, 20.0], [16384, 7.0, 0, 3.0]])
+    assert samples_to_20s(rows) == 12288 and samples_to_20s(rows[[0, 1, 3]]) is None

@@ -82,7 +82,8 @@ def test_quick_and_paper_presets_compose_with_the_papers_batch():
     ("style_walk_low_volume", "walk", "volume", "decrease", {"right_knee": 1.0, "neck": 0.7, "root": 0.7, "com_y": 0.2}),
     ("style_run_high_energy", "run", "energy", "increase", {"left_hip": 1.0, "right_elbow": 1.0, "chest": 0.7}),
     ("style_cartwheel_low_energy", "cartwheel", "energy", "decrease",
-     {"chest": np.inf, "right_knee": np.inf, "ee_left_wrist": np.inf, "root": 1.0, "neck": 1.0, "left_ankle": 1.0, "com_x": 0.2}),
+     {"chest": np.inf, "right_knee": np.inf, "ee_left_wrist": np.inf, "root": 0.7, "neck": 1.0, "left_ankle": 1.0,
+      "com_x": 0.3, "com_y": 0.2, "com_z": 0.3}),  # the authors' style_cartwheel.txt
     ("style_dance_high_energy", "dance_a", "energy", "increase", {"left_shoulder": 1.0, "root": 0.7, "ee_right_ankle": 0.5}),
 ])
 def test_style_presets_loosen_the_bounds_and_add_their_term(preset, clip, term, mode, widths):
