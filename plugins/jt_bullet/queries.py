@@ -31,10 +31,6 @@ class UnknownName(JtError, KeyError):
 class SceneQueries:
     """The query, scene and render half of ``toolkit.interfaces.Simulator`` on PyBullet."""
 
-    terrain_visuals: dict
-    """``{heightfield body: {"shape", "position", "orientation", "twin"}}``; ``twin`` is the id of
-    its drawn twin (None until the first ``render``)."""
-
     # ------------------------------------------------------------------ the character
     @property
     def body_id(self) -> int:
@@ -291,56 +287,10 @@ class SceneQueries:
             bodies.append(int(body))
         return tuple(bodies)
 
-    def add_heightfield(self, heights: np.ndarray, cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),
-                        friction: float = 0.9) -> int:
-        """Static terrain ``heights`` ``(n_x, n_z)`` (m) on a ``cell``-metre grid centred at
-        ``origin`` (y up: rows along x, columns along z); its handle."""
-        import pybullet as pb
-
-        from jt_bullet.scene import Z_TO_Y
-
-        h = np.asarray(heights, dtype=float)
-        if h.ndim != 2 or min(h.shape) < 2:
-            raise ValueError(f"heights must be (n_x, n_z) with n_x, n_z >= 2, got {h.shape}")
-        kw = {"physicsClientId": self.client}
-        n_x, n_z = h.shape
-        # PyBullet's heightfield is z-up with data row-major over (rows = y, columns = x) and is
-        # centred on the mid-height; turned by Z_TO_Y its local (x, y, z) become world (x, -z, y).
-        data = h[:, ::-1].T.reshape(-1)  # local y = -world z
-        col = pb.createCollisionShape(pb.GEOM_HEIGHTFIELD, meshScale=[cell, cell, 1.0], heightfieldData=data.tolist(),
-                                      numHeightfieldRows=n_x, numHeightfieldColumns=n_z,
-                                      flags=pb.GEOM_CONCAVE_INTERNAL_EDGE, **kw)  # no snags on edges
-        mid = 0.5 * (float(h.max()) + float(h.min()))
-        pos = [float(origin[0]), float(origin[1]) + mid, float(origin[2])]
-        # A body with no visual shape gets one converted from its collision shape, ~0.9 kB per
-        # height sample in every client (11 MB for the get-up terrain, per env): the physics body
-        # carries a speck 10 m under the ground instead, and the first ``render`` adds the seen
-        # terrain as a twin body that collides with nothing (``_show_terrain``).
-        speck = pb.createVisualShape(pb.GEOM_SPHERE, radius=1e-4, visualFramePosition=[0.0, 0.0, -10.0], **kw)
-        body = pb.createMultiBody(0.0, col, speck, pos, list(Z_TO_Y), **kw)
-        pb.changeDynamics(body, -1, lateralFriction=float(friction), **kw)
-        self.terrain_visuals[int(body)] = {"shape": int(col), "position": pos, "orientation": list(Z_TO_Y), "twin": None}
-        return int(body)
-
-    def _show_terrain(self) -> None:
-        """Give every heightfield its visual: a twin body on the same collision shape in collision
-        group 0 with mask 0 (no contacts, no ray hits, nothing added to the step's pairs)."""
-        import pybullet as pb
-
-        kw = {"physicsClientId": self.client}
-        for entry in self.terrain_visuals.values():
-            if entry["twin"] is None:
-                twin = pb.createMultiBody(0.0, entry["shape"], -1, entry["position"], entry["orientation"], **kw)
-                pb.setCollisionFilterGroupMask(twin, -1, 0, 0, **kw)
-                entry["twin"] = int(twin)
-
     def remove(self, body: int) -> None:
-        """Remove a scene body added by ``add_box`` / ``add_boxes`` / ``add_heightfield``."""
+        """Remove a scene body added by ``add_box`` / ``add_boxes``."""
         import pybullet as pb
 
-        entry = self.terrain_visuals.pop(int(body), None)
-        if entry is not None and entry["twin"] is not None:
-            pb.removeBody(entry["twin"], physicsClientId=self.client)
         pb.removeBody(int(body), physicsClientId=self.client)
         self._scene_planes = None  # a body made next would leave the count as it was
 
@@ -363,7 +313,6 @@ class SceneQueries:
         if target is None:
             pos, _ = pb.getBasePositionAndOrientation(self.character.body_id, physicsClientId=self.client)
             target = [v if math.isfinite(v) else 0.0 for v in pos]
-        self._show_terrain()
         return render_frame(self.client, target, width, height, camera)
 
     # ------------------------------------------------------------------ bullet-only extras

@@ -57,7 +57,6 @@ class BulletSimulator(SceneQueries, Simulator):
         from jt_bullet import scene
 
         super().__init__(cfg)
-        self.terrain_visuals: dict = {}  # heightfield body -> its drawn twin (SceneQueries.add_heightfield)
         self._scene_planes: tuple | None = None  # (n_bodies, ground ids or None), SceneQueries.ray
         self.params: SimConfig = typed(SimConfig, _get(cfg, "sim"), "sim")
         self.char_cfg = CharacterConfig.from_node(_get(cfg, "character"))

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 
-from typing import Any
 
 import numpy as np
 
@@ -139,9 +138,3 @@ class BulletBody:
     def step(self) -> None:
         """One ``stepSimulation``."""
         self.pb.stepSimulation(**self._kw)
-
-
-def model_and_body(client: int, body_id: int, **kw: Any) -> tuple[Model, BulletBody]:
-    """``Model.from_bullet`` and the matching ``BulletBody``."""
-    model = Model.from_bullet(client, body_id, **kw)
-    return model, BulletBody(client, body_id, model)

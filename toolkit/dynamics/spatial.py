@@ -104,18 +104,6 @@ def mat3_mul(A: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True, inline="always")
-def set_transform(R: np.ndarray, p: np.ndarray, E: np.ndarray, r: np.ndarray) -> None:
-    """Store the transform into a frame with orientation ``R`` ``(9,)`` and origin ``p`` ``(3,)``.
-
-    ``E = R^T`` (row-major), ``r = p``.
-    """
-    for i in range(3):
-        for j in range(3):
-            E[3 * i + j] = R[3 * j + i]
-        r[i] = p[i]
-
-
-@njit(cache=True, inline="always")
 def xform_motion(E: np.ndarray, r: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
     """``out = X v`` for a motion vector (A coordinates -> B coordinates)."""
     w0, w1, w2 = v[0], v[1], v[2]

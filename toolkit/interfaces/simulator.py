@@ -2,7 +2,7 @@
 
 An environment never names its simulator (MimicKit's engine interface): everything it needs goes
 through this interface — state I/O, the substep loop with the episode's termination rules checked
-inside it, batched link/CoM reads, contacts, static scene geometry (boxes, heightfields), ray
+inside it, batched link/CoM reads, contacts, static scene geometry (boxes), ray
 queries and rendering. ``Watch`` declares what ends a control step early and what to record at
 each checked substep, so Python runs once per control step, not once per 600 Hz substep.
 """
@@ -229,14 +229,8 @@ class Simulator(Plugin, abc.ABC):
         the simulator allows; their handles (what ``contacts`` names them by)."""
         raise NotImplementedError
 
-    def add_heightfield(self, heights: "np.ndarray", cell: float, origin: Sequence[float] = (0.0, 0.0, 0.0),
-                        friction: float = 0.9) -> int:
-        """Static terrain: ``heights`` ``(n_x, n_z)`` metres on a grid of ``cell`` metres, centred
-        at ``origin`` in the ground plane (y up); its handle."""
-        raise NotImplementedError
-
     def remove(self, body: int) -> None:
-        """Remove a scene body added by ``add_box`` / ``add_boxes`` / ``add_heightfield``."""
+        """Remove a scene body added by ``add_box`` / ``add_boxes``."""
         raise NotImplementedError
 
     # ------------------------------------------------------------------ output

@@ -63,9 +63,6 @@ def quat_conjugate(q) -> np.ndarray:
     return np.concatenate([-q[..., :3], q[..., 3:]], axis=-1)
 
 
-quat_inverse = quat_conjugate
-
-
 def quat_multiply(a, b) -> np.ndarray:
     """Hamilton product ``a * b`` ``(..., 4)``: rotate by ``b`` first, then by ``a``."""
     a, b = _arr(a), _arr(b)
@@ -300,11 +297,6 @@ def sixd_to_quat(d6) -> np.ndarray:
 def expmap_to_matrix(v) -> np.ndarray:
     """Rotation vectors ``(..., 3)`` → matrices ``(..., 3, 3)``."""
     return quat_to_matrix(quat_from_expmap(v))
-
-
-def matrix_to_expmap(m) -> np.ndarray:
-    """Matrices ``(..., 3, 3)`` → rotation vectors ``(..., 3)`` with ``|v| <= pi``."""
-    return quat_to_expmap(matrix_to_quat(m))
 
 
 def align_hemisphere(q, axis: int = 0) -> np.ndarray:

@@ -158,15 +158,6 @@ def find_prior(ref: str, store_root: Optional[str] = None, kind: str = "pvae") -
     return _find(str(ref).strip(), store_root, kind)
 
 
-def find_in_run(run_id: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
-    """The prior file among the artifacts of MLflow run ``run_id`` (else of its nested runs).
-
-    Raises:
-        JtError: no store, no such run, or no prior among its artifacts.
-    """
-    return _find(str(run_id), store_root, kind)
-
-
 def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] = None) -> PosePrior:
     """Load a prior from a file path, a folder holding one, or the id of the MLflow run that made it.
 

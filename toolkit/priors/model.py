@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from toolkit.motion import rotations as rot
-from toolkit.motion.features import FeatureLayout, features_to_joints
+from toolkit.motion.features import FeatureLayout
 from toolkit.motion.skeletons import SKELETONS, SPHERICAL, Skeleton
 
 KINDS = ("pvae", "cvae")
@@ -203,10 +203,6 @@ class PosePrior:
     def latent_from_action(self, a: np.ndarray) -> np.ndarray:
         """Whitened latent action ``(..., latent_dim)`` → latent ``z_mean + z_std * a``."""
         return self.z_mean + self.z_std * np.asarray(a, dtype=np.float64)
-
-    def decode_joints(self, z: np.ndarray, c: np.ndarray | None = None) -> np.ndarray:
-        """Joint rotations in the quaternion layout ``(..., n_q)`` decoded from ``z``."""
-        return features_to_joints(self.decode(z, c), self.layout)
 
     def decode_targets(self, z: np.ndarray, c: np.ndarray | None = None) -> np.ndarray:
         """PD targets in the dof layout ``(..., n_dof)`` (exp maps, angles): ``D_pose(z)``."""

@@ -142,8 +142,6 @@ class GetupTask(PolicyTask):
                                       for k in HISTORY]
             prev = np.asarray(extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
             prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
-            if prev.shape[1] < 1 + len(HISTORY):  # a run resumed from before a column was added
-                prev = np.hstack([prev, np.full((len(prev), 1 + len(HISTORY) - prev.shape[1]), math.nan)])
             extra["getup_history"] = np.vstack([prev, [row]])
             if progress is not None:
                 progress(min(samples / max(total, 1), 1.0), f"success {row[1]:.2f}")

@@ -266,13 +266,3 @@ class JumpEnv(CharacterEnv):
             "policy_features": np.asarray(self.spec_.policy_features, dtype=float).reshape(-1, 4)
             if len(self.spec_.policy_features) else np.zeros((0, 4)),
         }
-
-
-class EnvFactory:
-    """Picklable ``env_fn(seed) -> JumpEnv`` for PPO's rollout workers."""
-
-    def __init__(self, spec: EnvSpec) -> None:
-        self.spec = spec
-
-    def __call__(self, seed: int) -> JumpEnv:
-        return JumpEnv(self.spec, seed=seed)

@@ -151,15 +151,7 @@ class Suite:
         """Signed distance of ``points`` ``(..., 3)`` past the feature plane ``(...)``."""
         return np.asarray(points) @ self.normal - self.plane
 
-    def to_local(self, v: np.ndarray) -> np.ndarray:
-        """World vectors ``(..., 3)`` in the suite frame (normal, up, along) ``(..., 3)``."""
-        return np.asarray(v) @ self._rotation
-
     def rotation(self) -> np.ndarray:
         """Suite frame axes as columns ``(3, 3)`` (right-handed: normal × up = along), read-only:
         made once per frame (the observation reads it every control step)."""
         return self._rotation
-
-    def near_barrier(self, margin: float) -> bool:
-        """True when any part of the character is within ``margin`` of the wall / obstacle."""
-        return self.barrier_id >= 0 and self.sim.near(self.barrier_id, margin)

@@ -7,7 +7,7 @@ DeepMimic (Peng et al. 2018) as ``000`` §6.1.1 uses it for the run-up controlle
   simulation grid ``1 / sim_hz``; ``reset(options={"time": t0})`` fixes it);
 * the episode ends at the take-off instant: the ``n_strides``-th middle of a support phase of the
   take-off foot after ``t0`` (at least one control step later; same definition as
-  ``jt_tasks.jumping.takeoff``), so it lasts between ``n_strides - 1`` and ``n_strides`` cycles;
+  ``jt_tasks.takeoff.state.support_phase_time``), so it lasts between ``n_strides - 1`` and ``n_strides`` cycles;
   the last control step runs only the substeps left to that instant;
 * early termination: any body part other than the feet touching the ground, or a failed
   simulation (NaN / exploding), ends the episode without the task reward;
@@ -52,7 +52,7 @@ class RunupSpec:
     clip: str = "run"  # reference run (DeepMimic humanoid3d_run.txt)
     foot: str = "right"  # take-off foot
     n_strides: int = 2  # take-off-foot mid-supports up to the take-off (ours)
-    contact_tol: float = 0.06  # m: support-phase detection (jumping/takeoff.py)
+    contact_tol: float = 0.06  # m: support-phase detection (jt_tasks.takeoff.state)
     foot_clearance: float = 0.002  # m: take-off foot above the ground at take-off in the reference
     control_hz: float = 30.0  # Peng et al. 2018: policy queried at 30 Hz
     check_every: int = 1  # substeps between contact checks
@@ -176,22 +176,8 @@ class RunupEnv(CharacterEnv):
         info.update({f"target_{k}": v for k, v in self.targets.items()})
         return info
 
-    def takeoff_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The simulated ``(q, qd)`` now (world); call it when an episode ended at take-off."""
-        return self.sim.state()
-
     def close(self) -> None:
         if getattr(self, "ref", None) is not None:
             self.ref.close()
             self.ref = None
         super().close()
-
-
-class EnvFactory:
-    """Picklable ``env_fn(seed) -> RunupEnv`` for PPO's rollout workers."""
-
-    def __init__(self, spec: RunupSpec) -> None:
-        self.spec = spec
-
-    def __call__(self, seed: int) -> RunupEnv:
-        return RunupEnv(self.spec, seed=seed)

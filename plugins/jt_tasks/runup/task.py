@@ -59,7 +59,7 @@ class RunupConfig(PolicyConfig):
     n_strides: int = 2
     """The episode ends at the 2nd take-off-foot mid-support after the start (ours; 000 §3 defines the take-off instant)."""
     contact_tol: float = 0.06
-    """M: a foot this close to its lowest height is in support (ours, as jumping/takeoff.py)."""
+    """M: a foot this close to its lowest height is in support (ours, as jt_tasks.takeoff.state.support_phase_time)."""
     foot_clearance: float = 0.002
     """M: the take-off foot's height at take-off in the reference (ours, as the jump env)."""
     control_hz: float = 30.0

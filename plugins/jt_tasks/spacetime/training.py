@@ -78,12 +78,8 @@ class SpacetimeTraining:
         return float(s[:, 0].mean()), float(s[:, 1].mean()), float(s[:, 0].min())
 
     def history(self) -> np.ndarray:
-        """Rows ``(samples, mean survival_s, share survived, min survival_s)`` ``(n_evaluations, 4)``
-        (a run from before the several starts: its one episode's survival as the min)."""
-        rows = np.asarray(self.extra.get(EVAL_KEY, np.zeros((0, 4))), dtype=float)
-        if rows.ndim == 2 and rows.shape[1] == 3:
-            rows = np.hstack([rows, rows[:, 1:2]])
-        return rows.reshape(-1, 4)
+        """Rows ``(samples, mean survival_s, share survived, min survival_s)`` ``(n_evaluations, 4)``."""
+        return np.asarray(self.extra.get(EVAL_KEY, np.zeros((0, 4))), dtype=float).reshape(-1, 4)
 
 
 def samples_to_20s(rows: np.ndarray) -> Optional[float]:

@@ -26,9 +26,8 @@ from jt_tasks.standing_jump.model import Body, build_body, effort_weights, stand
 from toolkit.errors import JtError
 
 
-class UnusableSPD(JtError, ValueError):
-    """The ``spd`` group names a backend standing_jump cannot use (a one-line ``JtError``; also the
-    ``ValueError`` callers caught before)."""
+class UnusableSPD(JtError):
+    """The ``spd`` group names a backend standing_jump cannot use (a one-line ``JtError``)."""
 
 
 @dataclasses.dataclass

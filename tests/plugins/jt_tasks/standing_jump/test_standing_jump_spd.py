@@ -9,6 +9,7 @@ from omegaconf import OmegaConf
 from jt_tasks.standing_jump import StandingJumpTask
 from jt_tasks.standing_jump.model import build_body
 from jt_tasks.standing_jump.simulate import SimSettings, open_world, simulate, spd_backend
+from toolkit.errors import JtError
 
 DT = 1.0 / 600.0
 METHODS = ("maba", "df", "sf", "pcg")
@@ -74,7 +75,7 @@ def test_reduced_gravity_reaches_the_spd_model(world):
 
 def test_bullet_spd_is_refused(world):
     _, cid, robot, _ = world
-    with pytest.raises(ValueError, match="maba, df, sf or pcg"):
+    with pytest.raises(JtError, match="maba, df, sf or pcg"):
         spd_backend({"name": "bullet"}, cid, robot)
 
 
