@@ -17,6 +17,15 @@ _SMALL = 1e-6  # rotations._SMALL
 
 
 @njit(cache=True)
+def quat_mul(ax: float, ay: float, az: float, aw: float, bx: float, by: float, bz: float, bw: float) -> tuple:
+    """Hamilton product ``a b`` of two ``(x, y, z, w)`` quaternions given as scalars (the order of
+    ``rotations.quat_multiply``'s terms, so the same bits); ``conj(a) b`` is ``quat_mul(-ax, -ay,
+    -az, aw, ...)``, bit for bit the expanded form."""
+    return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+
+
+@njit(cache=True)
 def dofs_to_joints(dofs: np.ndarray, sph_dof: np.ndarray, sph_q: np.ndarray, rev_dof: np.ndarray,
                    rev_q: np.ndarray, out: np.ndarray) -> None:
     """``Skeleton.dofs_to_joints`` of one pose: dofs ``(n_dof,)`` -> ``out`` ``(n_q,)``.

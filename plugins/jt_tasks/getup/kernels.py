@@ -16,6 +16,8 @@ import math
 import numpy as np
 from numba import njit
 
+from toolkit.motion.kernels import quat_mul
+
 EPS = 1e-12  #: rotations._EPS: below this norm a vector / quaternion counts as zero
 SMALL = 1e-6  #: rotations._SMALL: below this half-angle sine the log map uses its series
 
@@ -70,11 +72,7 @@ def link_velocities(pos: np.ndarray, orn: np.ndarray, p0: np.ndarray, o0: np.nda
         for k in range(3):
             v[i, k] = (pos[i, k] - p0[i, k]) / dt
         ax, ay, az, aw = orn[i, 0], orn[i, 1], orn[i, 2], orn[i, 3]
-        bx, by, bz, bw = -o0[i, 0], -o0[i, 1], -o0[i, 2], o0[i, 3]
-        x = aw * bx + ax * bw + ay * bz - az * by
-        y = aw * by - ax * bz + ay * bw + az * bx
-        z = aw * bz + ax * by - ay * bx + az * bw
-        q = aw * bw - ax * bx - ay * by - az * bz
+        x, y, z, q = quat_mul(ax, ay, az, aw, -o0[i, 0], -o0[i, 1], -o0[i, 2], o0[i, 3])
         nq = math.sqrt(x * x + y * y + z * z + q * q)
         if nq > EPS:
             x, y, z, q = x / nq, y / nq, z / nq, q / nq

@@ -18,6 +18,8 @@ import math
 import numpy as np
 from numba import njit
 
+from toolkit.motion.kernels import quat_mul
+
 _EPS = 1e-12
 _SMALL = 1e-6
 
@@ -92,11 +94,7 @@ def sample(i: int, f: float, held: bool, cos_a: float, sin_a: float, p0: np.ndar
         else:
             scale = math.sin(0.5 * theta) / theta
         bx, by, bz, bw = v0 * scale, v1 * scale, v2 * scale, math.cos(0.5 * theta)
-        ax, ay, az, aw = q0[i, r, 0], q0[i, r, 1], q0[i, r, 2], q0[i, r, 3]
-        x = aw * bx + ax * bw + ay * bz - az * by
-        y = aw * by - ax * bz + ay * bw + az * bx
-        z = aw * bz + ax * by - ay * bx + az * bw
-        w = aw * bw - ax * bx - ay * by - az * bz
+        x, y, z, w = quat_mul(q0[i, r, 0], q0[i, r, 1], q0[i, r, 2], q0[i, r, 3], bx, by, bz, bw)
         n = math.sqrt(x * x + y * y + z * z + w * w)
         if n > _EPS:
             m = max(n, _EPS)
@@ -142,11 +140,7 @@ def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, pha
         out[2 + 3 * l], out[3 + 3 * l], out[4 + 3 * l] = _finite(px), _finite(py), _finite(pz)
     o = 2 + 3 * n
     for l in range(n):
-        bx, by, bz, bw = orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3]
-        x = iw * bx + ix * bw + iy * bz - iz * by
-        y = iw * by - ix * bz + iy * bw + iz * bx
-        z = iw * bz + ix * by - iy * bx + iz * bw
-        w = iw * bw - ix * bx - iy * by - iz * bz
+        x, y, z, w = quat_mul(ix, iy, iz, iw, orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3])
         if w < 0.0:
             x, y, z, w = -x, -y, -z, -w
         out[o + 4 * l], out[o + 4 * l + 1], out[o + 4 * l + 2], out[o + 4 * l + 3] = \
@@ -177,12 +171,7 @@ def difference(q: np.ndarray, com: np.ndarray, ee_world: np.ndarray, ref_q: np.n
         out[d] = abs(com[d] - ref_com[d])
     for r in range(cols.shape[0]):
         c = cols[r]
-        ax, ay, az, aw = q[c[0]], q[c[1]], q[c[2]], q[c[3]]
-        bx, by, bz, bw = ref_q[c[0]], ref_q[c[1]], ref_q[c[2]], ref_q[c[3]]
-        x = aw * bx - ax * bw - ay * bz + az * by
-        y = aw * by + ax * bz - ay * bw - az * bx
-        z = aw * bz - ax * by + ay * bx - az * bw
-        w = aw * bw + ax * bx + ay * by + az * bz
+        x, y, z, w = quat_mul(-q[c[0]], -q[c[1]], -q[c[2]], q[c[3]], ref_q[c[0]], ref_q[c[1]], ref_q[c[2]], ref_q[c[3]])
         out[at[r]] = 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
     for r in range(rev_at.shape[0]):
         out[rev_at[r]] = abs(q[rev_cols[r]] - ref_q[rev_cols[r]])

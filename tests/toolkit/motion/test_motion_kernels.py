@@ -53,3 +53,15 @@ def test_compiled_bspline_has_the_bits_of_the_basis_matrix_path(clamped, dim):
 
     kernels.bspline_basis(s, c.knots, 3, b)
     assert np.array_equal(b.view(np.uint64), basis_matrix(s, c.knots).view(np.uint64))
+
+
+def test_quat_mul_is_quat_multiply_bit_for_bit_and_conjugates_by_sign():
+    from toolkit.motion import rotations as rot
+    from toolkit.motion.kernels import quat_mul
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        a, b = rot.quat_normalize(rng.standard_normal(4)), rot.quat_normalize(rng.standard_normal(4))
+        assert np.array_equal(np.array(quat_mul(*a, *b)), rot.quat_multiply(a, b))
+        c = rot.quat_conjugate(a)
+        assert np.array_equal(np.array(quat_mul(-a[0], -a[1], -a[2], a[3], *b)), rot.quat_multiply(c, b))
