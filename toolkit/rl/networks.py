@@ -172,18 +172,20 @@ class ActorCritic(nn.Module):
         self.out_scale = None if out_scale is None else np.asarray(out_scale, dtype=np.float64).reshape(act_dim)
         self._scale = None if out_scale is None else torch.as_tensor(self.out_scale, dtype=torch.float32)
 
-    def _mean(self, x: torch.Tensor) -> torch.Tensor:
+    def policy_mean(self, x: torch.Tensor) -> torch.Tensor:
+        """Policy means ``(batch, act_dim)`` for *normalised* observations ``x``: the MLP's output
+        times ``out_scale`` (what the learner's log-densities must use, as the workers do)."""
         mu = self.pi(x)
         return mu if self._scale is None else mu * self._scale
 
     def forward(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Policy means ``(batch, act_dim)`` and values ``(batch,)`` for raw ``obs``."""
         x = self.norm(obs)
-        return self._mean(x), self.v(x).squeeze(-1)
+        return self.policy_mean(x), self.v(x).squeeze(-1)
 
     def mean_action(self, obs: torch.Tensor) -> torch.Tensor:
         """Policy means ``(batch, act_dim)`` (the deterministic action, before bounds)."""
-        return self._mean(self.norm(obs))
+        return self.policy_mean(self.norm(obs))
 
     def value(self, obs: torch.Tensor) -> torch.Tensor:
         """State values ``(batch,)``."""

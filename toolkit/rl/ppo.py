@@ -194,7 +194,7 @@ def ppo_update(
             idx = perm[start:start + cfg.minibatch_size]
             x = model.norm(obs[idx])
             # policy: clipped surrogate (Schulman et al. 2017)
-            logp = gaussian_log_prob(model.pi(x), std, act[idx])
+            logp = gaussian_log_prob(model.policy_mean(x), std, act[idx])
             log_ratio = logp - old_logp[idx]
             ratio = log_ratio.exp()
             a = adv_t[idx]

@@ -163,3 +163,22 @@ def test_target_kl_stops_an_update_early():
     assert early.history["mean_return"][0] == full.history["mean_return"][0]  # same first batch
     loose = train(ENV, tiny(epochs=4, n_workers=1, policy_lr=1e-2, optimizer="adam", target_kl=1e9))
     assert _learning_stats(loose.history) == _learning_stats(full.history)  # never reached: the paper's loop
+
+
+class ScaledEnvFn:
+    """Pendulum whose env declares ``policy_output_scale`` (as ``action=ffc_fbc`` does)."""
+
+    def __call__(self, seed: int):
+        env = ENV(seed)
+        env.unwrapped.policy_output_scale = np.array([3.0])
+        return env
+
+
+def test_an_env_output_scale_is_the_learners_mean_too():
+    """The workers sample around the scaled mean; the learner's log-densities must use the same
+    mean, so the first minibatch's ratio is 1: with a tiny actor rate the update's KL and clip
+    fraction stay near 0 (a learner that forgot the scale sees KL ~ 1 and clips everything)."""
+    cfg = tiny(policy_lr=1e-7, epochs=1, total_samples=256, n_workers=1)
+    r = train(ScaledEnvFn(), cfg)
+    assert r.model.out_scale is not None and r.model.out_scale[0] == 3.0
+    assert r.history["approx_kl"][0] < 1e-3 and r.history["clip_frac"][0] < 0.01
