@@ -78,6 +78,18 @@ def test_quick_and_paper_presets_compose_with_the_papers_batch():
     assert paper.agent.n_workers == 18 and paper.task.eval_time_limit == 20.0
 
 
+def test_the_table1_preset_is_the_measured_walk_run_with_its_cost():
+    """``experiment=table1``: the walk at Table 1's 4.1 M samples, the paper's PPO, the authors'
+    output scale, 4 evaluation starts every 10 iterations, 2 workers; a cost line to print first."""
+    t, cfg = task("experiment=table1")
+    assert cfg.task.clip == "walk" and cfg.agent.total_samples == 1001 * 4096 and cfg.agent.n_workers == 2
+    assert cfg.agent.policy_lr == 2.5e-6 and cfg.agent.optimizer == "sgd" and cfg.action.output_scale == "range"
+    assert (cfg.task.eval_every, cfg.task.eval_starts, cfg.task.termination) == (10, 4, "bounds")
+    assert "min" in str(cfg.cost) and "2 cores" in str(cfg.cost)
+    _, run = task("experiment=table1", "task.clip=run")
+    assert run.task.clip == "run" and run.agent.total_samples == cfg.agent.total_samples
+
+
 @pytest.mark.parametrize("preset, clip, term, mode, widths", [
     ("style_walk_low_volume", "walk", "volume", "decrease", {"right_knee": 1.0, "neck": 0.7, "root": 0.7, "com_y": 0.2}),
     ("style_run_high_energy", "run", "energy", "increase", {"left_hip": 1.0, "right_elbow": 1.0, "chest": 0.7}),
