@@ -2,7 +2,8 @@
 
 Every default lives in a plugin's ``Config`` dataclass (``toolkit.schema``). This walks every
 config group file in ``conf/`` and every preset, and fails on a value equal to what it overrides —
-the dataclass default for a group file, the group file's value (or the default) for a preset —
+the dataclass default for a group file, the group file's value (or the default) and the presets it
+composes for a preset —
 unless its line carries a citation comment (a paper code ``000``…``004``, "authors' code",
 "paper", DeepMimic or SB3): a deliberate restatement that says where the value comes from.
 """
@@ -70,6 +71,19 @@ def _raw(path: Path) -> dict:
     return node if isinstance(node, dict) else {}
 
 
+def _inherited(preset: Path, group: str) -> dict:
+    """The values of ``group`` that the presets in ``preset``'s defaults list give it (in order)."""
+    out: dict = {}
+    for entry in _raw(preset).get("defaults", []) or []:
+        if isinstance(entry, str) and not entry.startswith(("override", "_self_")):
+            parent = CONF / "preset" / f"{entry.split('/')[-1]}.yaml"
+            if parent.exists():
+                out.update(_inherited(parent, group))
+                node = _raw(parent).get(group)
+                out.update(node if isinstance(node, dict) else {})
+    return out
+
+
 def _all_restatements() -> list[str]:
     from toolkit.config import compose
 
@@ -93,6 +107,7 @@ def _all_restatements() -> list[str]:
                 continue
             own = CONF / group / f"{name}.yaml"
             base = {k: v for k, v in _raw(own).items() if k != "defaults"} if name and own.exists() else {}
+            base.update(_inherited(f, group))  # a preset composing another overrides that one
             found += restatements(f"{f.relative_to(ROOT)}: {group}", f.read_text(), node, schema, base)
     return found
 
