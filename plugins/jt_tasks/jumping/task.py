@@ -27,6 +27,21 @@ from jt_tasks.jumping.config import JumpConfig, LongJumpConfig, ObstacleConfig
 from jt_tasks.policy.task import PolicyTask, require_humanoid_and_prior
 
 
+def require_own_control_rate(cfg: Any, task: str) -> None:
+    """One ``JtError`` line when ``sim.control_hz`` is set for a jump: the bar-height curriculum
+    sets the control rate (000 §6.1.2: 10 → 30 Hz, ``curriculum.control_hz_start`` / ``_span``)."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    sim = group_of(cfg, "sim")
+    if sim is None or "control_hz" not in sim:
+        return
+    default = getattr(getattr(plugins.load("sim", str(sim.name)), "Config", None), "control_hz", None)
+    if default is not None and float(sim.control_hz) != float(default):
+        raise JtError(f"sim.control_hz={sim.control_hz}: task={task} takes its control rate from the curriculum "
+                      f"(curriculum.control_hz_start, curriculum.control_hz_span; 000 §6.1.2), not from sim")
+
+
 class JumpTask(PolicyTask):
     """Base of the jumping tasks: take-off features → trained policy → strategy feature (000 §6.1)."""
 
@@ -42,8 +57,10 @@ class JumpTask(PolicyTask):
     @classmethod
     def check_run(cls, cfg: Any) -> None:
         """The jumps need the humanoid (their take-off states come from its clips) and, for the
-        P-VAE / C-VAE action spaces, a trained prior."""
+        P-VAE / C-VAE action spaces, a trained prior; their control rate is the curriculum's, so a
+        ``sim.control_hz`` other than the simulator's default is refused, not ignored."""
         require_humanoid_and_prior(cfg, cls.Config().name, "its take-off states come from the DeepMimic humanoid's clips")
+        require_own_control_rate(cfg, cls.Config().name)
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

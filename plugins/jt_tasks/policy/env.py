@@ -45,6 +45,8 @@ class CharacterEnv(gymnasium.Env):
 
     Attributes:
         sim: the simulator plugin; ``sim_hz``, ``n_links``, ``masses`` ``(n_links + 1,)`` from it.
+        control_hz: the control rate (Hz): the simulator's (``sim.control_hz``) unless the task's
+            ``setup`` sets its own (the jumps' curriculum owns theirs).
         action_space_: the action-space plugin; ``skeleton`` its skeleton.
         watch: the termination rules of an episode (set by ``setup``).
         done: the episode has ended (``step`` then needs a ``reset``).
@@ -67,6 +69,7 @@ class CharacterEnv(gymnasium.Env):
         self.render_mode = render_mode
         self.sim = load_simulator(spec.sim)
         self.sim_hz = float(self.sim.sim_hz)
+        self.control_hz = float(self.sim.control_hz)  # a task whose rate is its own sets it in setup()
         self.n_links = int(self.sim.n_links)
         self.masses = np.asarray(self.sim.masses)
         action = dict(spec.action)

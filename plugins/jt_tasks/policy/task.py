@@ -193,7 +193,7 @@ class PolicyTask(Task):
                 if not self.retry_rollout(env, ro):
                     break
             data, attrs = self.rollout_data(ro, env, spec)
-            fps = float(getattr(env, "control_hz", 30.0))
+            fps = float(env.control_hz)
         finally:
             env.close()
         written = tr.save_motion(workdir, ro["frames"], p.filmstrip_frames, fps)

@@ -11,7 +11,7 @@ DeepMimic (Peng et al. 2018) as ``000`` §6.1.1 uses it for the run-up controlle
   the last control step runs only the substeps left to that instant;
 * early termination: any body part other than the feet touching the ground, or a failed
   simulation (NaN / exploding), ends the episode without the task reward;
-* control at ``control_hz`` (30 Hz), ``round(sim_hz / control_hz)`` substeps at the simulator's
+* control at ``sim.control_hz`` (30 Hz, Peng et al. 2018), ``round(sim_hz / control_hz)`` substeps at the simulator's
   rate (600 Hz), the action space plugin (``raw``: the action is the PD targets) giving the
   internal joints' PD targets.
 
@@ -54,7 +54,6 @@ class RunupSpec:
     n_strides: int = 2  # take-off-foot mid-supports up to the take-off (ours)
     contact_tol: float = 0.06  # m: support-phase detection (jt_tasks.takeoff.state)
     foot_clearance: float = 0.002  # m: take-off foot above the ground at take-off in the reference
-    control_hz: float = 30.0  # Peng et al. 2018: policy queried at 30 Hz
     check_every: int = 1  # substeps between contact checks
     w_imitation: float = 0.7  # ours (DeepMimic's task examples use 0.7 / 0.3)
     w_goal: float = 0.3  # ours
@@ -69,7 +68,6 @@ class RunupEnv(CharacterEnv):
     def setup(self) -> None:
         spec = self.spec_
         self.targets = rw.goal_targets(spec.kind, spec.target, spec.omega_y)
-        self.control_hz = float(spec.control_hz)
         self.substeps = max(1, int(round(self.sim_hz / self.control_hz)))
         self.feet = {FOOT_LINKS["right"], FOOT_LINKS["left"]}
         self.ref = RunReference(spec.clip, spec.foot, spec.contact_tol, spec.foot_clearance, self.sim_hz)

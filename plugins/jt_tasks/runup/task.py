@@ -62,8 +62,6 @@ class RunupConfig(PolicyConfig):
     """M: a foot this close to its lowest height is in support (ours, as jt_tasks.takeoff.state.support_phase_time)."""
     foot_clearance: float = 0.002
     """M: the take-off foot's height at take-off in the reference (ours, as the jump env)."""
-    control_hz: float = 30.0
-    """Hz, policy rate (Peng et al. 2018: 30 Hz); the sim rate is sim.sim_hz (600 Hz, 000 §6.2)."""
     check_every: int = 1
     """Substeps between early-termination contact checks (ours: every 600 Hz substep)."""
     w_imitation: float = 0.7
@@ -123,7 +121,7 @@ class RunupTask(PolicyTask):
         sim, action = self.character_groups()
         return RunupSpec(kind=p.kind, target={k: float(feats[k]) for k in self.feature_names},
                          omega_y=p.omega_y, clip=p.clip, foot=p.foot, n_strides=p.n_strides,
-                         contact_tol=p.contact_tol, foot_clearance=p.foot_clearance, control_hz=p.control_hz,
+                         contact_tol=p.contact_tol, foot_clearance=p.foot_clearance,
                          check_every=p.check_every, w_imitation=p.w_imitation, w_goal=p.w_goal,
                          goal_steps=p.goal_steps, sim=sim, action=action)
 

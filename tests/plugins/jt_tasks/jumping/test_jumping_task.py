@@ -96,3 +96,16 @@ def test_final_fallback_steps_down_one_dz_to_z_min(enabled):
             assert not task.retry_rollout(env, {})  # it crossed: keep the rollout
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("task", ["highjump", "obstacle", "longjump"])
+def test_sim_control_hz_is_refused_by_the_jumps_whose_rate_is_the_curriculums(task):
+    """``sim.control_hz`` means the same for every task: the jumps' rate is their curriculum's,
+    so setting it is one line naming the curriculum's keys, not a value silently ignored."""
+    from toolkit.config import compose
+    from toolkit.errors import JtError
+
+    with pytest.raises(JtError, match="curriculum.control_hz_start") as e:
+        compose([f"task={task}", "sim.control_hz=60"])
+    assert "\n" not in str(e.value)
+    compose([f"task={task}", "sim.control_hz=30"])  # the default is no choice

@@ -149,3 +149,16 @@ def test_same_seed_same_episode():
     finally:
         a.close()
         b.close()
+
+
+def test_the_control_rate_is_the_simulators():
+    """``sim.control_hz`` drives the run-up as it drives getup and spacetime (one value, one place)."""
+    from toolkit import plugins
+    from toolkit.config import compose
+
+    for hz, substeps in ((30, 20), (60, 10)):
+        e = plugins.load("task", "runup")(compose(["task=runup", f"sim.control_hz={hz}"])).make_env(seed=0)
+        try:
+            assert e.control_hz == hz and e.substeps == substeps
+        finally:
+            e.close()
