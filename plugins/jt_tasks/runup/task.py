@@ -114,7 +114,7 @@ class RunupTask(PolicyTask):
         """The ``RunupSpec`` for target features ``point`` (missing ones: the defaults)."""
         from jt_tasks.runup.env import RunupSpec
 
-        p, cfg = self.params, self.cfg
+        p = self.params
         _, defaults = self.box()
         feats = {**defaults, **{k: float(v) for k, v in point.items()},
                  **{k: float(v) for k, v in (p.point or {}).items()}}
