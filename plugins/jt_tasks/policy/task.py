@@ -23,7 +23,6 @@ import dataclasses
 from pathlib import Path
 from typing import Any, Callable, ClassVar, Optional
 
-
 from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
