@@ -137,11 +137,25 @@ def _choice(parsed: Sequence[Any], group: str) -> Optional[str]:
 
 
 def _preset(parsed: Sequence[Any]) -> list[str]:
-    """``preset=<experiment>_<task>`` when such a preset exists (it may choose groups itself)."""
+    """``preset=<experiment>_<task>`` when such a preset exists (it may choose groups itself).
+
+    Raises:
+        JtError: an ``experiment=`` other than ``default`` that the task has no preset for (it
+            would silently run the task's defaults), naming the experiments the task has.
+    """
     if _choice(parsed, "preset") is not None:
         return []
-    name = f"{_choice(parsed, 'experiment') or 'default'}_{_choice(parsed, 'task')}"
-    return [f"preset={name}"] if name in group_options("preset") else []
+    experiment, task = _choice(parsed, "experiment") or "default", _choice(parsed, "task")
+    presets = group_options("preset")
+    name = f"{experiment}_{task}"
+    if name in presets:
+        return [f"preset={name}"]
+    if experiment != "default" and task is not None:
+        known = sorted({p[: -len(task) - 1] for p in presets if p.endswith(f"_{task}")} | {"default"})
+        known = [e for e in known if e in group_options("experiment")]
+        raise JtError(f"experiment={experiment}: task={task} has no preset for it (preset/{name}.yaml), so it would "
+                      f"run the task's defaults; its experiments: {', '.join(known)}")
+    return []
 
 
 def compose(overrides: Sequence[str] = (), run_checks: bool = True) -> Any:

@@ -87,3 +87,15 @@ def test_executor_workers_is_the_interface_s_key(monkeypatch):
         assert str(e.value).startswith(f"executor.workers={bad}") and "\n" not in str(e.value)
     monkeypatch.setattr(plugins, "load", real)
     assert compose(["task=zdt1", "executor.workers=3"]).executor.workers == 3  # executor=local declares it
+
+
+def test_an_experiment_a_task_has_no_preset_for_is_one_line_naming_its_experiments():
+    """``task=getup experiment=laptop`` used to run the task's defaults (the paper's 100 M samples)
+    without a word; now it is refused, naming the experiments getup has."""
+    from toolkit.errors import JtError
+
+    with pytest.raises(JtError, match=r"experiment=laptop: task=getup has no preset.*its experiments: default, paper, quick, smoke") as e:
+        compose(["task=getup", "experiment=laptop"])
+    assert "\n" not in str(e.value)
+    assert compose(["task=getup", "experiment=quick"]).profile == "quick"
+    assert compose(["task=getup"]).profile == "default"  # no experiment named: the task's defaults
