@@ -25,15 +25,19 @@ from toolkit.interfaces.simulator import BASE, ContactRule, Watch
 
 
 def run_state() -> tuple[np.ndarray, np.ndarray]:
-    """A frame of the run clip with the stance foot on the ground (``toolkit.dynamics`` layout)."""
-    from jt_tasks.takeoff.state import reference_state, support_phase_time
+    """The run clip's frame whose right ankle is lowest (the stance foot on the ground), with its
+    velocities (``toolkit.dynamics`` layout); from ``toolkit.motion`` alone, so a third party's
+    simulator runs this suite without jt's plugins."""
     from toolkit.motion import load_clip
+    from toolkit.motion.kinematics import clip_velocities, forward_kinematics
     from toolkit.motion.skeletons import motions_dir
 
     clip = load_clip(f"{motions_dir()}/humanoid3d_run.txt")
-    t, _ = support_phase_time(clip, "right", 0.06)
-    p, r, j, v, w, jv = reference_state(clip, t)
-    return np.concatenate([p, r, j]), np.concatenate([v, w, jv])
+    kin = forward_kinematics(clip.skeleton, clip.root_pos, clip.root_rot, clip.joints)
+    i = int(np.argmin(kin.joint_pos[:, kin.links.index("right_ankle"), 1]))
+    vel = clip_velocities(clip)
+    return (np.concatenate([clip.root_pos[i], clip.root_rot[i], clip.joints[i]]),
+            np.concatenate([vel.root_lin[i], vel.root_ang[i], vel.joints[i]]))
 
 
 class SimulatorContract:
