@@ -50,6 +50,13 @@ class PVAEActionSpace(DofActionSpace):
         clip_to_limits: bool = True
         """Targets within the joint limits."""
 
+    @classmethod
+    def prior_run(cls, action: Any) -> list[str] | None:
+        """With ``prior: auto``: ``task=pose_prior action=<this space>`` trains its prior."""
+        if str(action.get("prior", "")).strip() != "auto":
+            return None
+        return ["task=pose_prior", f"action={cls.kind}"]
+
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)
         from toolkit.priors.io import load_prior

@@ -17,7 +17,7 @@ import math
 import signal
 import sys
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -82,6 +82,13 @@ class _Terminate:
             signal.signal(signal.SIGTERM, self._old)
 
 
+def _train_prior(store: Any, overrides: Sequence[str], tag: str) -> str:
+    """Train an action space's prior into ``store`` (``jt run <overrides>``, ``toolkit.priors.auto``); its run id."""
+    from toolkit.config import compose
+
+    return run(compose([*overrides, f"store={store.root}"])).run_id
+
+
 def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     """Run a composed, validated config (see ``toolkit.config.compose``) to completion.
 
@@ -100,7 +107,7 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     task = task_cls(cfg)
     problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
     search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
-    cfg = auto_prior.resolve(cfg)  # action.prior=auto: the store's own prior, trained on first use
+    cfg = auto_prior.resolve(cfg, _train_prior)  # action.prior=auto: the store's own prior, trained on first use
     store = Store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)
     nested = bool(getattr(search_cls, "nested", True))

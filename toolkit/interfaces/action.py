@@ -58,6 +58,13 @@ class ActionSpace(GroupPlugin, abc.ABC):
     def targets(self, action: "np.ndarray", obs: Any = None) -> "np.ndarray":
         """PD targets for the character's internal joints from ``action`` ``(dim,)``."""
 
+    @classmethod
+    def prior_run(cls, action: Any) -> "list[str] | None":
+        """The ``jt run`` overrides that train this action space's prior when its ``action``
+        config asks for the store's own one (``action.prior=auto``, ``toolkit.priors.auto``), or
+        None: nothing to train first (the default)."""
+        return None
+
     def penalty(self) -> float:
         """The action space's own reward term for the last step (1.0 = no penalty)."""
         return 1.0

@@ -11,31 +11,40 @@ saved config then names that prior run, so a resumed or repeated run uses the sa
 from __future__ import annotations
 
 import sys
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 AUTO = "auto"
 """The ``action.prior`` value that asks for the store's own prior."""
-KINDS = ("pvae", "cvae")
 TAG = "jt.auto_prior"
-"""Tag on a pose_prior run trained for ``action.prior=auto`` (its value: the prior kind)."""
+"""Tag on a prior run trained for ``action.prior=auto`` (its value: the action space's name)."""
+
+
+def prior_run(cfg: Any) -> list[str]:
+    """The overrides of the run that trains ``cfg``'s action-space prior when ``cfg`` asks for
+    ``action.prior=auto`` (the action space's ``ActionSpace.prior_run`` hook), else ``[]``; also
+    ``[]`` for that training run itself (its task is the one the overrides name)."""
+    from toolkit import plugins
+
+    action = cfg.get("action") if hasattr(cfg, "get") else None
+    if action is None or "name" not in action:
+        return []
+    hook = getattr(plugins.load("action", str(action.name)), "prior_run", None)
+    overrides = list(hook(action) or []) if hook is not None else []
+    if f"task={cfg.task.name}" in overrides:
+        return []
+    return overrides
 
 
 def wants_auto(cfg: Any) -> str:
-    """The prior kind (``"pvae"`` / ``"cvae"``) when ``cfg`` asks for ``action.prior=auto``, else ``""``."""
-    action = cfg.get("action") if hasattr(cfg, "get") else None
-    if action is None or str(cfg.task.name) == "pose_prior":
-        return ""
-    kind = str(action.get("name", ""))
-    if kind in KINDS and str(action.get("prior", "")).strip() == AUTO:
-        return kind
-    return ""
+    """The action space's name when ``cfg`` asks for ``action.prior=auto``, else ``""``."""
+    return str(cfg.action.name) if prior_run(cfg) else ""
 
 
-def find(store: Any, tag: str) -> str:
+def find(store: Any, tag: str, experiment: str) -> str:
     """Id of the newest finished auto prior run tagged ``tag`` (``pvae``, ``cvae``, ``pvae@smoke``
-    ...) in ``store`` whose ``prior.h5`` is there, or ``""``."""
+    ...) in ``store``'s ``experiment`` whose prior still loads, or ``""``."""
     kind = tag.split("@")[0]
-    exp = store.client.get_experiment_by_name("pose_prior")
+    exp = store.client.get_experiment_by_name(experiment)
     if exp is None:
         return ""
     runs = store.client.search_runs(
@@ -52,39 +61,33 @@ def find(store: Any, tag: str) -> str:
     return ""
 
 
-def resolve(cfg: Any, train_overrides: Sequence[str] = ()) -> Any:
+def resolve(cfg: Any, train: Callable[[Any, Sequence[str], str], str], train_overrides: Sequence[str] = ()) -> Any:
     """``cfg`` with ``action.prior=auto`` replaced by a prior run id of this store (trained if needed).
 
     Args:
         cfg: a composed, validated config; returned unchanged unless it asks for ``auto``.
+        train: ``train(store, overrides, tag) -> run id``: runs the prior's training (the runner
+            passes its own ``run``, so this module never calls it back).
         train_overrides: extra overrides of the prior's own run (tests: ``experiment=smoke``).
     """
-    kind = wants_auto(cfg)
-    if not kind:
+    overrides = prior_run(cfg)
+    if not overrides:
         return cfg
     from toolkit.store.tracking import Store, store_root
 
+    kind = str(cfg.action.name)
+    experiment = next(o.partition("=")[2] for o in overrides if o.startswith("task="))
     store = Store(store_root(str(cfg.store)))
     smoke = str(cfg.get("profile", "default")) == "smoke"  # a smoke run gets a smoke-sized prior
     tag = f"{kind}@smoke" if smoke else kind
-    run_id = find(store, tag)
+    run_id = find(store, tag, experiment)
     if run_id:
         print(f"jt: action.prior=auto: the store's {kind} prior, run {run_id}", file=sys.stderr, flush=True)
     else:
-        run_id = train(store, kind, [*(["experiment=smoke"] if smoke else []), *train_overrides], tag)
+        print(f"jt: action.prior=auto: no {kind} prior in this store yet; training one from the shipped "
+              f"clips first (about a minute; later runs reuse it): jt run {' '.join(overrides)}",
+              file=sys.stderr, flush=True)
+        run_id = train(store, [*overrides, *(["experiment=smoke"] if smoke else []), *train_overrides], tag)
+        store.set_tags(run_id, {TAG: tag})
     cfg.action.prior = run_id
     return cfg
-
-
-def train(store: Any, kind: str, overrides: Sequence[str] = (), tag: str = "") -> str:
-    """Train the default ``kind`` prior into ``store`` (``jt run task=pose_prior action=<kind>``); its run id."""
-    from toolkit.config import compose
-    from toolkit.execution.runner import run
-
-    print(f"jt: action.prior=auto: no {kind} prior in this store yet; training one from the shipped "
-          f"clips first (about a minute; later runs reuse it): jt run task=pose_prior action={kind}",
-          file=sys.stderr, flush=True)
-    conf = compose(["task=pose_prior", f"action={kind}", f"store={store.root}", *overrides])
-    res = run(conf)
-    store.set_tags(res.run_id, {TAG: tag or kind})
-    return res.run_id
