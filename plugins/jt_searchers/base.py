@@ -96,6 +96,31 @@ def feasible_mask(problem: SearchProblem, box: UnitBox, u: np.ndarray) -> np.nda
     return margins >= 0.0
 
 
+def unit_samples(n: int, dim: int, seed: int, method: str = "uniform") -> np.ndarray:
+    """``n`` points of the unit cube ``(n, dim)``, a deterministic function of the arguments.
+
+    Args:
+        n: number of points.
+        dim: dimension.
+        seed: seed of the generator (or of the Sobol scrambling).
+        method: ``"uniform"`` (i.i.d.) or ``"sobol"`` (scrambled Sobol', ``scipy.stats.qmc``).
+    """
+    if method == "uniform":
+        return np.random.default_rng(seed).random((n, dim))
+    if method == "sobol":
+        from scipy.stats import qmc
+
+        if n == 0 or dim == 0:
+            return np.zeros((n, dim))
+        try:
+            sampler = qmc.Sobol(d=dim, scramble=True, rng=np.random.default_rng(seed))
+        except TypeError:  # scipy < 1.15 names the argument ``seed``
+            sampler = qmc.Sobol(d=dim, scramble=True, seed=np.random.default_rng(seed))
+        m = int(np.ceil(np.log2(max(n, 1))))
+        return sampler.random_base2(m)[:n]  # a power of two keeps the balance properties
+    raise ValueError(f"unknown sampling method {method!r} (use 'uniform' or 'sobol')")
+
+
 def feasible_samples(problem: SearchProblem, box: UnitBox, n: int, seed: int, method: str = "uniform") -> np.ndarray:
     """``n`` seeded unit points within ``problem.constraint``.
 
@@ -109,7 +134,7 @@ def feasible_samples(problem: SearchProblem, box: UnitBox, n: int, seed: int, me
         box: the unit-cube map of its space.
         n: number of points.
         seed: seed of the design.
-        method: ``"uniform"`` or ``"sobol"`` (``random_search.unit_samples``).
+        method: ``"uniform"`` or ``"sobol"`` (``unit_samples``).
 
     Returns:
         Unit points ``(n, dim)``.
@@ -117,8 +142,6 @@ def feasible_samples(problem: SearchProblem, box: UnitBox, n: int, seed: int, me
     Raises:
         JtError: fewer than ``n`` feasible points in ``n + 20 x 64 n`` draws.
     """
-    from jt_searchers.random_search import unit_samples
-
     u = unit_samples(n, box.dim, seed, method)
     if problem.constraint is None or n == 0:
         return u

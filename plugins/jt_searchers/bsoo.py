@@ -29,9 +29,8 @@ import numpy as np
 
 from toolkit.errors import JtError
 
-from jt_searchers.base import BudgetedSearcher, seed_int, check_budget
+from jt_searchers.base import BudgetedSearcher, seed_int, check_budget, unit_samples
 from jt_searchers.mo_cmaes import objectives_of
-from jt_searchers.random_search import unit_samples
 
 
 def binned_objective(

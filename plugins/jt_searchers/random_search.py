@@ -10,32 +10,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from jt_searchers.base import BudgetedSearcher, check_budget
-
-
-def unit_samples(n: int, dim: int, seed: int, method: str = "uniform") -> np.ndarray:
-    """``n`` points of the unit cube ``(n, dim)``, a deterministic function of the arguments.
-
-    Args:
-        n: number of points.
-        dim: dimension.
-        seed: seed of the generator (or of the Sobol scrambling).
-        method: ``"uniform"`` (i.i.d.) or ``"sobol"`` (scrambled Sobol', ``scipy.stats.qmc``).
-    """
-    if method == "uniform":
-        return np.random.default_rng(seed).random((n, dim))
-    if method == "sobol":
-        from scipy.stats import qmc
-
-        if n == 0 or dim == 0:
-            return np.zeros((n, dim))
-        try:
-            sampler = qmc.Sobol(d=dim, scramble=True, rng=np.random.default_rng(seed))
-        except TypeError:  # scipy < 1.15 names the argument ``seed``
-            sampler = qmc.Sobol(d=dim, scramble=True, seed=np.random.default_rng(seed))
-        m = int(np.ceil(np.log2(max(n, 1))))
-        return sampler.random_base2(m)[:n]  # a power of two keeps the balance properties
-    raise ValueError(f"unknown sampling method {method!r} (use 'uniform' or 'sobol')")
+from jt_searchers.base import BudgetedSearcher, check_budget, feasible_samples
 
 
 class RandomSearcher(BudgetedSearcher):
@@ -65,8 +40,6 @@ class RandomSearcher(BudgetedSearcher):
     def __init__(self, problem: Any, cfg: Any, seed: int) -> None:
         super().__init__(problem, cfg, seed)
         # The whole design is drawn up front, so the points never depend on how asks are batched.
-        from jt_searchers.base import feasible_samples
-
         self._design = feasible_samples(problem, self.box, self.budget, seed, self.cfg.method)
 
     def _propose(self, k: int) -> np.ndarray:

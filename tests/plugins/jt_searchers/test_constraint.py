@@ -62,7 +62,8 @@ def test_unconstrained_bds_does_go_outside() -> None:
 
 @pytest.mark.parametrize("method", ["uniform", "sobol"])
 def test_random_search_samples_within_the_constraint(method) -> None:
-    from jt_searchers.random_search import RandomSearcher, unit_samples
+    from jt_searchers.base import unit_samples
+    from jt_searchers.random_search import RandomSearcher
 
     X = _run(RandomSearcher, {"budget": 40, "method": method}, seed=3)
     assert len(X) == 40 and np.all(_margin(X) >= 0.0)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from jt_searchers.random_search import RandomSearcher, unit_samples
+from jt_searchers.base import unit_samples
+from jt_searchers.random_search import RandomSearcher
 from jt_tasks.strategy_landscape import StrategyLandscapeTask
 from toolkit.testing.searcher import SearcherContract, run_batches
 
