@@ -97,13 +97,6 @@ class SamplingParams:
     evolution_reading: str
     decay: float
 
-    @classmethod
-    def defaults(cls, **changes: Any) -> "SamplingParams":
-        """``SpacetimeConfig()``'s knobs (the paper's), with ``changes`` applied."""
-        from jt_tasks.spacetime.task import SpacetimeConfig
-
-        return dataclasses.replace(SpacetimeConfig().sampling_params(), **changes)
-
 
 class StartSampler:
     """Eq 11 start-phase weights and eq 12 start-state buffers, kept in ``extra`` (checkpointed).

@@ -13,6 +13,15 @@ from spacetime_helpers import make_env
 W = [10.0, 15.0, 20.0]  # the research notes' worked example
 
 
+def _defaults(**changes):
+    """``SpacetimeConfig()``'s sampling knobs (the paper's), with ``changes`` applied."""
+    import dataclasses
+
+    from jt_tasks.spacetime.task import SpacetimeConfig
+
+    return dataclasses.replace(SpacetimeConfig().sampling_params(), **changes)
+
+
 @pytest.mark.parametrize("reading, expected", [("paper", [0.695, 0.207, 0.098]), ("code", [0.472, 0.312, 0.216])])
 def test_eq11_worked_example_both_readings(reading, expected):
     p = sm.is_probabilities(W, 0.2, reading)
@@ -41,7 +50,7 @@ def starts_with_low_segment(low: int, n: int = 10, per: int = 5) -> list[dict]:
 
 
 def test_importance_weights_favour_the_segment_with_low_returns():
-    s = sm.StartSampler(sm.SamplingParams.defaults(), {}, seed=0)
+    s = sm.StartSampler(_defaults(), {}, seed=0)
     for it in range(3):
         pay = s.update(it + 1, 4096 * (it + 1), type("S", (), {"starts": starts_with_low_segment(3)})())
     p = pay["start_sampling"]["probs"]
@@ -54,7 +63,7 @@ def test_importance_weights_favour_the_segment_with_low_returns():
 
 
 def test_importance_off_is_uniform():
-    s = sm.StartSampler(sm.SamplingParams.defaults(importance=False), {}, seed=0)
+    s = sm.StartSampler(_defaults(importance=False), {}, seed=0)
     p = s.update(1, 10, type("S", (), {"starts": starts_with_low_segment(3)})())["start_sampling"]["probs"]
     assert np.allclose(p, 0.1)
 
@@ -67,7 +76,7 @@ def visits(n: int, seed: int, d: int = 5) -> list[dict]:
 
 @pytest.mark.parametrize("reading", ["paper", "code"])
 def test_evolution_keeps_m_states_per_segment_and_leans_as_its_reading(reading):
-    params = sm.SamplingParams.defaults(evolution=True, buffer_size=20, evolution_reading=reading,
+    params = _defaults(evolution=True, buffer_size=20, evolution_reading=reading,
                                decay=0.95 if reading == "code" else 1.0)
     s = sm.StartSampler(params, {}, seed=0)
     v = visits(2000, 1)
@@ -85,7 +94,7 @@ def test_evolution_keeps_m_states_per_segment_and_leans_as_its_reading(reading):
 
 def test_evolution_is_seeded():
     def run(seed):
-        s = sm.StartSampler(sm.SamplingParams.defaults(evolution=True, buffer_size=8), {}, seed=seed)
+        s = sm.StartSampler(_defaults(evolution=True, buffer_size=8), {}, seed=seed)
         s.refresh(visits(500, 3), 1)
         return s.state["states"].copy()
 
@@ -134,7 +143,7 @@ def test_ppo_reports_visits_with_targets_and_the_starts_follow_the_payload():
     from spacetime_helpers import make_spec
 
     spec = make_spec(sampling={"evolution": True}, time_limit=0.5)
-    sampler = sm.StartSampler(sm.SamplingParams.defaults(evolution=True, buffer_size=4, n_segments=4), {}, seed=0)
+    sampler = sm.StartSampler(_defaults(evolution=True, buffer_size=4, n_segments=4), {}, seed=0)
     seen: list = []
 
     def on_iteration(it, samples, stats):
