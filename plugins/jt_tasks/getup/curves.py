@@ -112,11 +112,18 @@ def load_getup_clip(clip: str, mirrored: bool = False) -> Any:
 
 @functools.lru_cache(maxsize=8)
 def clip_feature_track(clip: str, mirrored: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """``(times (n,), features (n, 3))`` of a clip's frames (neck height above y = 0, θx, θz)."""
+    """``(times (n,), features (n, 3))`` of a clip's frames: θx, θz and the neck height above the
+    ground the frame rests on — its own lowest point less ``ground.CLEARANCE``, the frame a start
+    pose is put in (``ground.lift_to_ground``). The clips' mocap ground is 3-5 cm off and not
+    level (the faceup clip ends 2.7 cm lower than it starts): heights above y = 0 put every
+    simulated height 3.6-7.5 cm above its curve (issue 29)."""
+    from jt_tasks.getup.ground import CLEARANCE, lowest_point
     from toolkit.motion.features import clip_features
 
     c = load_getup_clip(clip, mirrored)
-    _, cond, _ = clip_features(c, ground_height=0.0)
+    ground = np.array([lowest_point(np.concatenate([c.root_pos[i], c.root_rot[i], c.joints[i]]))
+                       for i in range(c.n_frames)]) - CLEARANCE
+    _, cond, _ = clip_features(c, ground_height=ground)
     return np.asarray(c.times, float), np.asarray(cond, float)
 
 

@@ -124,7 +124,7 @@ def replay_reference(env: Any, curve: str) -> dict[str, np.ndarray]:
     import math as _m
 
     from jt_tasks.getup.curves import load_getup_clip
-    from jt_tasks.getup.initial import lift_to_ground
+    from jt_tasks.getup.ground import lift_to_ground
     from jt_tasks.takeoff.state import reference_state
 
     env.reset(seed=0, options={"kind": "clip", "curve": curve})

@@ -15,36 +15,16 @@
 
 from __future__ import annotations
 
-import functools
 import math
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
 from toolkit.motion import rotations as rot
 
+from jt_tasks.getup.ground import lift_to_ground
+
 STYLES = ("prone", "supine")  #: the rag-doll drop postures (003 §5.2)
-CLEARANCE = 0.005  #: m between the lowest point of a start pose and the ground (ours)
-
-
-@functools.lru_cache(maxsize=1)
-def _kinematic_body() -> Any:
-    from toolkit.motion.kinematics import KinematicBody
-    from toolkit.motion.skeletons import HUMANOID
-
-    return KinematicBody(HUMANOID)
-
-
-def lowest_point(q: np.ndarray) -> float:
-    """Lowest height of the humanoid's bounding boxes in pose ``q`` (a kinematic copy, never stepped)."""
-    return _kinematic_body().lowest_point(np.asarray(q, dtype=np.float64))
-
-
-def lift_to_ground(q: np.ndarray, ground: float = 0.0, clearance: float = CLEARANCE) -> np.ndarray:
-    """``q`` moved up or down so that its lowest point is ``clearance`` above ``ground``."""
-    q = np.array(q, dtype=np.float64)
-    q[1] += ground + clearance - lowest_point(q)
-    return q
 
 
 def clip_pose(clip: str, mirrored: bool = False, frame: int = 0, ground: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

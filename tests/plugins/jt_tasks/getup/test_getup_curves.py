@@ -43,7 +43,7 @@ def test_reference_curves_from_the_clips_and_mirrors():
     down, mir = reference_curve("facedown"), reference_curve("facedown_mirror")
     assert down.control.shape == (9, 3) and down.duration == pytest.approx(3.03, abs=0.01)
     assert math.degrees(down.start[2]) == pytest.approx(157.0, abs=1.0)
-    assert down.end[0] == pytest.approx(1.33, abs=0.01)
+    assert down.end[0] == pytest.approx(1.367, abs=0.01)  # the standing neck above the ground the pose rests on
     np.testing.assert_allclose(mir.control[:, 1], math.pi - down.control[:, 1], atol=1e-6)
     # notes: the 9-point curves replayed through r_h r_θ, mean 0.78 / 0.73 (facedown / faceup)
     assert replay_score(down)["mean"] == pytest.approx(0.78, abs=0.01)
@@ -65,3 +65,28 @@ def test_authored_curves_durations_and_bad_input():
         build_curves(["sit"], bad, None)
     c = cs[0]
     assert FeatureCurve.from_dict(c.to_dict()).to_dict() == c.to_dict()
+
+
+def test_a_clip_start_and_its_curve_measure_heights_from_the_same_ground():
+    """The simulated neck height at a clip's start pose equals its curve's p_h(0) to 1 cm (issue 29:
+    +3.6 cm facedown, +4.8 cm faceup, when the curves measured heights above the mocap's y = 0 and
+    the starts were lifted onto the ground); the facedown curve also ends at the standing start's
+    height."""
+    from toolkit import plugins
+    from toolkit.config import compose
+
+    env = plugins.load("task", "getup")(compose(["task=getup", "action=raw", "task.n_fallen=0"])).make_env(seed=0)
+    try:
+        seen = 0
+        for i, c in enumerate(env.curves):
+            if not c.clip:
+                continue
+            env.reset(options={"kind": "clip", "curve": i})
+            assert env.measure()["features"][0] == pytest.approx(c(0.0)[0], abs=0.01), c.name
+            if c.name == "facedown":  # the standing start is this clip's last frame
+                env.reset(options={"kind": "standing", "curve": i})
+                assert env.measure()["features"][0] == pytest.approx(c(c.duration)[0], abs=0.01)
+            seen += 1
+        assert seen == 4
+    finally:
+        env.close()

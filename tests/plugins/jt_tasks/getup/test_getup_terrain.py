@@ -108,7 +108,8 @@ def test_height_map_and_h_follow_the_terrain(world):
 
 
 def test_rag_doll_drops_land_on_the_terrain_at_seeded_locations():
-    from jt_tasks.getup.initial import fallen_states, lowest_point
+    from jt_tasks.getup.ground import lowest_point
+    from jt_tasks.getup.initial import fallen_states
 
     spec = T.TerrainSpec()
     kw = dict(styles=("prone",), settle_max=1.0, max_tries=1, terrain=spec.to_dict(), region=2)
