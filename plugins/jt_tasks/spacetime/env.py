@@ -36,6 +36,7 @@ frame and the joint velocities.
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, Optional
 
 import numpy as np
@@ -56,6 +57,7 @@ class SpacetimeSpec:
     loop: Optional[bool] = None
     ground_clearance: float = 0.001  # a penetrating start is lifted to this (authors' code)
     cycle_turn: bool = True
+    root_orientation: str = "world"  # world: in the reference cycle's frame (002 §4.1) | heading
     ffc_lead: float = 0.0  # control steps the FFC's phase leads the control step's start
     ffc_velocity: bool = False  # the reference's joint velocities as the PD target velocity
     termination: str = "bounds"  # bounds | contact
@@ -249,8 +251,10 @@ class SpacetimeEnv(CharacterEnv):
         q, qd = self.sim.state()
         pos, orn = self.sim.link_states()
         obs = np.empty(2 + 7 * len(pos) + len(qd), dtype=np.float32)
+        half = -0.5 * self.ref.cycle_yaw(self.clip_time)
         kernels.observe(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), pos, orn,
-                        self.ref.phase(self.clip_time), self.axis == "z", obs)
+                        self.ref.phase(self.clip_time), self.axis == "z", self.spec_.root_orientation == "world",
+                        math.sin(half), math.cos(half), obs)
         return obs
 
     def style_reward(self, q: np.ndarray, qd: np.ndarray) -> float:

@@ -126,11 +126,13 @@ def _finite(x: float) -> float:
 
 @njit(cache=True)
 def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, phase: float, axis_z: bool,
-            out: np.ndarray) -> None:
+            root_world: bool, fy: float, fw: float, out: np.ndarray) -> None:
     """The observation (``SpacetimeEnv.observe``) into ``out`` ``(2 + 7 n + n_dof,)`` float32:
     phase, root height, link CoMs ``pos`` ``(n, 3)`` relative to the ground-projected root and
     orientations ``orn`` ``(n, 4)`` (w >= 0) in the heading frame, root velocities in the heading
-    frame, joint velocities; NaN and inf as 0."""
+    frame, joint velocities; NaN and inf as 0. With ``root_world`` the root's orientation (link 0)
+    is taken in the frame ``(0, fy, 0, fw)`` (the inverse of the reference cycle's yaw; the world
+    frame when cycles do not turn) instead of the heading frame (002 §4.1)."""
     ix, iy, iz, iw = heading_inverse(q[3], q[4], q[5], q[6], axis_z)
     n = pos.shape[0]
     out[0], out[1] = _finite(phase), _finite(q[1])
@@ -140,7 +142,10 @@ def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, pha
         out[2 + 3 * l], out[3 + 3 * l], out[4 + 3 * l] = _finite(px), _finite(py), _finite(pz)
     o = 2 + 3 * n
     for l in range(n):
-        x, y, z, w = quat_mul(ix, iy, iz, iw, orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3])
+        if l == 0 and root_world:
+            x, y, z, w = quat_mul(0.0, fy, 0.0, fw, orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3])
+        else:
+            x, y, z, w = quat_mul(ix, iy, iz, iw, orn[l, 0], orn[l, 1], orn[l, 2], orn[l, 3])
         if w < 0.0:
             x, y, z, w = -x, -y, -z, -w
         out[o + 4 * l], out[o + 4 * l + 1], out[o + 4 * l + 2], out[o + 4 * l + 3] = \

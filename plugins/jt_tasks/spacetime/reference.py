@@ -248,6 +248,11 @@ class SpacetimeReference:
         x = float(t) / self.period
         return x % 1.0 if self.loop else min(max(x, 0.0), 1.0)
 
+    def cycle_yaw(self, t: float) -> float:
+        """Rad, the yaw about the up axis by which the cycle of clip time ``t`` is turned from the
+        first (``k turn``; 0 without ``cycle_turn`` or for a clip that does not loop)."""
+        return self._locate(t)[0] * self.turn
+
     def _locate(self, t: float) -> tuple[int, int, float, bool]:
         """``(cycle, frame, fraction, held)`` of clip time ``t``."""
         T = self.period

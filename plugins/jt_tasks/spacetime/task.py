@@ -94,6 +94,8 @@ class SpacetimeConfig(PolicyConfig):
     """M, a start that penetrates the ground is lifted so that its lowest point is this high; other starts and the reference are the clip's own (authors' code: 0.001)."""
     cycle_turn: bool = True
     """A looping clip's next cycle carries on its heading change (the walk turns 0.12 rad per cycle), so the reference is where a character tracking the clip goes (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam)."""
+    root_orientation: str = "world"
+    """Frame of the root's orientation in the observation: world, the reference cycle's frame (the world frame when cycles do not turn), so the policy sees the heading the bounds hold (002 §4.1: every kinematic quantity in the motion-direction frame except the root orientation; authors' code: use_global_root_ori); heading: in the root's own heading frame like the other links (jt before 2026-12, which hides the heading drift that ends the walk by its lateral CoM bound)."""
     ffc_lead: float = 0.0
     """Control steps by which the FFC's reference pose leads the control step's start (002 and the authors' code: 0, the pose at the start of the step held over its substeps)."""
     ffc_velocity: bool = False
@@ -159,6 +161,8 @@ class SpacetimeConfig(PolicyConfig):
 
         load_humanoid_clip(self.clip)
         require(self.heading_axis in (None, "x", "z"), "task.heading_axis", self.heading_axis, "x or z (null: per clip)")
+        require(self.root_orientation in ("world", "heading"), "task.root_orientation", self.root_orientation,
+                "world or heading")
         require(self.termination in ("bounds", "contact"), "task.termination", self.termination,
                 "bounds (002 §3.2) or contact (the DeepMimic baseline)")
         com = list(self.com_width) if isinstance(self.com_width, (list, tuple)) else self.com_width
@@ -236,6 +240,7 @@ class SpacetimeTask(PolicyTask):
         allowed = allowed_links(HUMANOID, clip, None if p.allowed_contacts is None else list(p.allowed_contacts))
         return SpacetimeSpec(clip=str(p.clip), heading_axis=self.heading_axis(), loop=p.loop,
                              ground_clearance=float(p.ground_clearance), cycle_turn=bool(p.cycle_turn),
+                             root_orientation=str(p.root_orientation),
                              ffc_lead=float(p.ffc_lead), ffc_velocity=bool(p.ffc_velocity), termination=p.termination,
                              widths=[float(x) for x in w],
                              width_table=bd.width_table(HUMANOID, w, p.width_table).tolist(), time_limit=float(p.time_limit), hold_s=float(p.hold_s),

@@ -244,3 +244,53 @@ def test_the_ffc_target_velocity_is_the_references_joint_velocity_at_the_ffcs_ti
         assert plain.pd_velocity_targets() is None
     finally:
         plain.close()
+
+
+def _root_obs(env, obs):
+    n = len(env.sim.link_states()[0])
+    o = 2 + 3 * n
+    return np.asarray(obs[o:o + 4], dtype=float)
+
+
+def _canonical(x):
+    x = np.asarray(x, dtype=float)
+    return -x if x[3] < 0 else x
+
+
+def test_the_root_orientation_is_observed_in_the_world_frame_and_the_other_links_in_the_heading_frame(env):
+    """002 §4.1: every kinematic quantity in the motion-direction frame except the root
+    orientation; the heading option keeps the old observation (the root in its own heading frame)."""
+    from jt_tasks.spacetime.reference import heading_quat
+    from toolkit.motion import rotations as rot
+
+    obs, _ = env.reset(options={"phase": 0.3})
+    q, _ = env.sim.state()
+    np.testing.assert_allclose(_root_obs(env, obs), _canonical(q[3:7]), atol=1e-6)
+    other = make_env(seed=0, root_orientation="heading")
+    try:
+        obs_h, _ = other.reset(options={"phase": 0.3})
+        inv = rot.quat_conjugate(heading_quat(q[3:7], env.axis))
+        np.testing.assert_allclose(_root_obs(other, obs_h), _canonical(rot.quat_multiply(inv, q[3:7])), atol=1e-6)
+        assert np.abs(_root_obs(other, obs_h) - _root_obs(env, obs)).max() > 0.01  # the run clip's heading is not 0
+        n = 2 + 3 * len(env.sim.link_states()[0])
+        np.testing.assert_allclose(obs_h[:n], obs[:n], atol=1e-6)  # phase, height, link positions
+        np.testing.assert_allclose(obs_h[n + 4:], obs[n + 4:], atol=1e-6)  # other links, velocities
+    finally:
+        other.close()
+
+
+def test_a_turned_cycle_observes_the_root_in_that_cycles_frame():
+    """With cycle_turn, cycle k of the walk is yawed by k turn: the observed root orientation is
+    the one of cycle 0 at the same phase, so the policy sees its heading relative to the bounds'."""
+    e = make_env(seed=0, clip="walk")
+    try:
+        assert abs(e.ref.turn) > 0.05
+        obs0, _ = e.reset(options={"phase": 0.3})
+        r0 = _root_obs(e, obs0)
+        e.t0 += 2.0 * e.ref.period  # the same phase two cycles on, whose reference is yawed by 2 turn
+        ref = e.ref.sample(e.clip_time)
+        e.sim.reset(ref.q, ref.qd)
+        np.testing.assert_allclose(_root_obs(e, e.observe()), r0, atol=1e-5)
+        assert e.ref.cycle_yaw(e.clip_time) == pytest.approx(2.0 * e.ref.turn)
+    finally:
+        e.close()

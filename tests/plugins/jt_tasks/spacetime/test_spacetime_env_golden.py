@@ -4,7 +4,9 @@ the same observations, rewards, terminations, infos and evolution states, to 1e-
 machine's). Recorded before the hot path was rewritten (issue 26, which kept them to 1e-9), and
 again when the task's behaviour changed on purpose (issue 28: the reference at the clip's own
 height with starts lifted only when they penetrate, cycles that carry on the clip's turn, the end
-effectors in the authors' order).
+effectors in the authors' order). The recorded cases keep the observation they were recorded with
+(``root_orientation="heading"``); ``walk_root_world`` records the default since issue 28's
+root-orientation change (002 §4.1: the root orientation in the world frame).
 
 Cases: the walk and the run with bounds (every early end is an out-of-bounds one), the DeepMimic
 arm (contact rule, imitation reward), a style run (eq 5's volume term), eq 13's mix, a per-phase
@@ -55,6 +57,10 @@ CASES = {
     "walk_evaluate": (dict(clip="walk"), 60, lambda k: {"evaluate": True}),
     "walk_evolution": (dict(clip="walk", sampling={"evolution": True}), 60, "payload"),
 }
+
+
+CASES = {k: ({"root_orientation": "heading", **kw}, n, o) for k, (kw, n, o) in CASES.items()}
+CASES["walk_root_world"] = (dict(clip="walk"), 80, None)
 
 
 def _run(name: str) -> dict:
