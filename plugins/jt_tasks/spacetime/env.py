@@ -42,6 +42,9 @@ from typing import Any, Optional
 import numpy as np
 
 from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.spec import default_of
+from jt_tasks.spacetime import clips
+from jt_tasks.spacetime.config import SpacetimeConfig as _C
 from jt_tasks.spacetime import bounds as bd
 from jt_tasks.spacetime.reference import END_EFFECTORS, SpacetimeReference, heading_frame, heading_quat
 from toolkit.interfaces.simulator import ContactRule, Watch
@@ -50,27 +53,30 @@ from toolkit.motion import rotations as rot
 
 @dataclasses.dataclass
 class SpacetimeSpec:
-    """Everything a spacetime environment needs, as plain picklable data (``SpacetimeTask.env_spec``)."""
+    """Everything a spacetime environment needs, as plain picklable data (``SpacetimeTask.env_spec``).
 
-    clip: str = "run"
-    heading_axis: str = "x"
-    loop: Optional[bool] = None
-    ground_clearance: float = 0.001  # a penetrating start is lifted to this (authors' code)
-    cycle_turn: bool = True
-    root_orientation: str = "world"  # world: in the reference cycle's frame (002 §4.1) | heading
-    ffc_lead: float = 0.0  # control steps the FFC's phase leads the control step's start
-    ffc_velocity: bool = False  # the reference's joint velocities as the PD target velocity
-    termination: str = "bounds"  # bounds | contact
+    A field named as one of ``SpacetimeConfig``'s has its default from there (its source and
+    meaning are documented there); the rest are the task's resolved values."""
+
+    clip: str = default_of(_C, "clip")
+    heading_axis: Optional[str] = default_of(_C, "heading_axis")  # x | z; None: per clip (clips.heading_axis)
+    loop: Optional[bool] = default_of(_C, "loop")
+    ground_clearance: float = default_of(_C, "ground_clearance")
+    cycle_turn: bool = default_of(_C, "cycle_turn")
+    root_orientation: str = default_of(_C, "root_orientation")
+    ffc_lead: float = default_of(_C, "ffc_lead")
+    ffc_velocity: bool = default_of(_C, "ffc_velocity")
+    termination: str = default_of(_C, "termination")
     widths: list = dataclasses.field(default_factory=list)  # (n_channels,), inf = off; [] = 002 §5.1
     width_table: list = dataclasses.field(default_factory=list)  # (K, n_channels) over phase [0, 1]; [] = widths
-    time_limit: float = 20.0
-    hold_s: float = 0.5
-    init_phase: Optional[float] = None
-    train_allowed: tuple = (5, 11)  # links allowed on the ground in the contact arm
-    eval_allowed: tuple = (5, 11)  # links allowed on the ground in the evaluation
-    eval_time_limit: float = 20.0
-    style: list = dataclasses.field(default_factory=list)  # [{"name": term, ...params}] (jt.rewards)
-    mix: Optional[float] = None  # eq 13 weight w_s of the style terms in the contact arm (None: product)
+    time_limit: float = default_of(_C, "time_limit")
+    hold_s: float = default_of(_C, "hold_s")
+    init_phase: Optional[float] = default_of(_C, "init_phase")
+    train_allowed: Optional[tuple] = None  # link indices allowed on the ground in the contact arm; None: per clip
+    eval_allowed: Optional[tuple] = None  # ... in the evaluation; None: per clip (clips.allowed_links)
+    eval_time_limit: float = default_of(_C, "eval_time_limit")
+    style: list = default_of(_C, "style")  # [{"name": term, ...params}] (jt.rewards)
+    mix: Optional[float] = default_of(_C, "mix")
     sampling: dict = dataclasses.field(default_factory=dict)  # {"evolution": bool} (sampling.SamplingParams)
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "ffc_fbc"})
@@ -86,8 +92,11 @@ class SpacetimeEnv(CharacterEnv):
         from toolkit import plugins
 
         spec = self.spec_
-        self.ref = SpacetimeReference(spec.clip, spec.heading_axis, spec.loop, spec.cycle_turn)
-        self.axis = spec.heading_axis
+        self.axis = clips.heading_axis(spec.clip, spec.heading_axis)
+        self.ref = SpacetimeReference(spec.clip, self.axis, spec.loop, spec.cycle_turn)
+        per_clip = clips.allowed_links(self.skeleton, spec.clip)
+        self.train_allowed = per_clip if spec.train_allowed is None else tuple(spec.train_allowed)
+        self.eval_allowed = per_clip if spec.eval_allowed is None else tuple(spec.eval_allowed)
         self.substeps = int(self.sim.n_substeps)
         self.control_hz = self.sim_hz / self.substeps
         self.names = bd.channel_names(self.skeleton)
@@ -134,12 +143,12 @@ class SpacetimeEnv(CharacterEnv):
         if hasattr(self.action_space_, "reset"):
             self.action_space_.reset(ref.phase)
         if evaluate:
-            limit, rules = float(spec.eval_time_limit), self._rule(tuple(spec.eval_allowed))
+            limit, rules = float(spec.eval_time_limit), self._rule(self.eval_allowed)
         else:
             limit = float(spec.time_limit)
             if not self.ref.loop:
                 limit = min(limit, self.ref.period + float(spec.hold_s) - self.t0)
-            rules = self._rule(tuple(spec.train_allowed)) if spec.termination == "contact" else ()
+            rules = self._rule(self.train_allowed) if spec.termination == "contact" else ()
         self.limit = max(limit, 1.0 / self.control_hz)
         self.watch = Watch(rules=rules, time_limit=self.limit, time_limit_outcome="truncate")
         self._inv = None

@@ -3,14 +3,22 @@
 import dataclasses
 import numpy as np
 from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.spec import default_of, spec_of
 from jt_tasks.policy.task import PolicyConfig, PolicyTask
 from toolkit.interfaces import ContactRule, Watch
+
+@dataclasses.dataclass
+class StandConfig(PolicyConfig):     # filmstrip_frames, _width, _height come from PolicyConfig
+    name: str = "stand"
+    """Registry name."""
+    time_limit: float = 5.0
+    """s of standing asked for (ours)."""
 
 @dataclasses.dataclass
 class StandSpec:                      # picklable: rollout workers rebuild the env from it
     sim: dict
     action: dict
-    time_limit: float = 5.0
+    time_limit: float = default_of(StandConfig, "time_limit")  # one default: the Config's
 
 class StandEnv(CharacterEnv):
     FEET = (5, 11)                    # the humanoid's ankle links
@@ -32,13 +40,6 @@ class StandEnv(CharacterEnv):
         fell = rec["outcome"] == "fail"
         return (0.0 if fell else 1.0), fell, rec["outcome"] == "truncate", {"reason": rec["reason"]}
 
-@dataclasses.dataclass
-class StandConfig(PolicyConfig):     # filmstrip_frames, _width, _height come from PolicyConfig
-    name: str = "stand"
-    """Registry name."""
-    time_limit: float = 5.0
-    """s of standing asked for (ours)."""
-
 class StandTask(PolicyTask):
     """Stay up: a minimal policy task."""
     Config = StandConfig
@@ -46,4 +47,4 @@ class StandTask(PolicyTask):
 
     def env_spec(self, point):
         sim, action = self.character_groups()      # sim, spd, character, action groups as dicts
-        return StandSpec(sim=sim, action=action, time_limit=self.params.time_limit)
+        return spec_of(StandSpec, self.params, sim=sim, action=action)  # shared fields copied

@@ -17,7 +17,7 @@ def _defaults(**changes):
     """``SpacetimeConfig()``'s sampling knobs (the paper's), with ``changes`` applied."""
     import dataclasses
 
-    from jt_tasks.spacetime.task import SpacetimeConfig
+    from jt_tasks.spacetime.config import SpacetimeConfig
 
     return dataclasses.replace(SpacetimeConfig().sampling_params(), **changes)
 

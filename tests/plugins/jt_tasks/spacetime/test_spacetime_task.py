@@ -19,7 +19,7 @@ def task(*overrides):
 def test_composes_with_its_groups_and_every_field_has_a_source():
     import dataclasses
 
-    from jt_tasks.spacetime.task import SpacetimeConfig
+    from jt_tasks.spacetime.config import SpacetimeConfig
 
     t, cfg = task()
     assert cfg.action.name == "ffc_fbc" and cfg.agent.name == "ppo_spacetime" and cfg.spd.name == "df"
@@ -49,6 +49,15 @@ def test_env_spec_feeds_the_task_clip_to_the_ffc_and_picks_the_heading_axis():
     assert spec.heading_axis == "x" and set(spec.eval_allowed) == {5, 11, 8, 14}
     t, _ = task("task.clip=roll")
     assert len(t.env_spec({}).eval_allowed) == 16  # roll: everything may touch
+
+
+def test_a_spacetime_spec_without_heading_or_contacts_resolves_them_per_clip():
+    from spacetime_helpers import make_env
+
+    env = make_env(clip="roll")
+    assert env.axis == "z" and len(env.eval_allowed) == env.n_links + 1  # roll: every link may touch
+    env = make_env(clip="run")
+    assert env.axis == "x" and env.eval_allowed == (5, 11)
 
 
 @pytest.mark.parametrize("override, match", [
