@@ -43,6 +43,7 @@ PROTOTYPES: dict[str, tuple[Any, tuple[Any, ...]]] = {
     "b3GetNumBodies": (I32, (I64,)),
     "b3GetLinkState": (I32, (I64, I64, I32, I64)),
     "b3RequestActualStateCommandComputeForwardKinematics": (I32, (I64, I32)),
+    "b3RequestActualStateCommandComputeLinkVelocity": (I32, (I64, I32)),
 }
 
 #: EnumSharedMemoryServerStatus values (Bullet's SharedMemoryPublic.h); ``handle`` confirms the

@@ -139,6 +139,14 @@ class CompiledSteps:
         self.fl.link_states(self.fns, self.h, self.body, self.holder, self.ls, pos, orn)
         return pos, orn
 
+    def link_velocities(self) -> tuple[np.ndarray, np.ndarray]:
+        """New arrays: world linear and angular velocities ``(n_links + 1, 3)`` of the base and
+        every link's centre of mass (``SceneQueries.link_velocities``)."""
+        lin = np.empty((self._n_links + 1, 3))
+        ang = np.empty((self._n_links + 1, 3))
+        self.fl.link_velocities(self.fns, self.h, self.body, self.holder, self.ls, lin, ang)
+        return lin, ang
+
     def link_frames(self, links: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """New arrays: URDF-frame positions ``(n, 3)`` and orientations ``(n, 4)`` of ``links``
         ``(n,)`` int64 (-1: the base), by forward kinematics (``SceneQueries.link_poses``)."""

@@ -84,13 +84,14 @@ _C = (
     ("clock_gettime", _c_call(_i32, _i32, _i64)),
     ("b3GetLinkState", _c_call(_i32, _i64, _i64, _i32, _i64)),
     ("b3RequestActualStateCommandComputeForwardKinematics", _c_call(_i32, _i64, _i32)),
+    ("b3RequestActualStateCommandComputeLinkVelocity", _c_call(_i32, _i64, _i32)),
 )
 (_submit, _status_type, _step_init, _state_init, _actual_state, _control_init, _set_forces,
  _contact_init, _contact_filter_a, _contact_info, _closest_init, _closest_a, _closest_b,
- _closest_threshold, _memcpy, _clock, _link_state, _with_fk) = (c for _n, c in _C)
+ _closest_threshold, _memcpy, _clock, _link_state, _with_fk, _with_vel) = (c for _n, c in _C)
 (SUBMIT, STATUS_TYPE, STEP_INIT, STATE_INIT, ACTUAL_STATE, CONTROL_INIT, SET_FORCES, CONTACT_INIT,
  CONTACT_FILTER_A, CONTACT_INFO, CLOSEST_INIT, CLOSEST_A, CLOSEST_B, CLOSEST_THRESHOLD, MEMCPY,
- CLOCK, LINK_STATE, WITH_FK) = range(len(_C))
+ CLOCK, LINK_STATE, WITH_FK, WITH_VEL) = range(len(_C))
 LINK_STATE_DOUBLES = 33  #: sizeof(struct b3LinkState) / 8 (SharedMemoryPublic.h)
 
 
@@ -144,6 +145,28 @@ def link_states(fns, h, body, holder, ls, pos, orn) -> None:
             pos[link + 1, i] = ls[i]
         for i in range(4):
             orn[link + 1, i] = ls[3 + i]
+
+
+@njit(cache=True)
+def link_velocities(fns, h, body, holder, ls, lin, ang) -> None:
+    """World linear ``lin`` and angular ``ang`` velocities ``(n_links + 1, 3)`` of the base and every
+    link's centre of mass, as PyBullet's getBaseVelocity and getLinkStates(computeLinkVelocity=1)
+    report them (the same request and the same fields: ``m_worldLinearVelocity`` /
+    ``m_worldAngularVelocity``, from the current joint velocities)."""
+    cmd = _state_init(fns[STATE_INIT], (h, body))
+    _with_vel(fns[WITH_VEL], (cmd, 1))
+    status = _submit(fns[SUBMIT], (h, cmd))
+    hp = holder.ctypes.data
+    _actual_state(fns[ACTUAL_STATE], (status, 0, 0, 0, 0, 0, hp, 0))
+    _memcpy(fns[MEMCPY], (ls.ctypes.data, holder[0], 6 * 8))  # the base's qdot: v, w (world)
+    for i in range(3):
+        lin[0, i] = ls[i]
+        ang[0, i] = ls[3 + i]
+    for link in range(lin.shape[0] - 1):
+        _link_state(fns[LINK_STATE], (h, status, link, ls.ctypes.data))
+        for i in range(3):
+            lin[link + 1, i] = ls[21 + i]  # m_worldLinearVelocity
+            ang[link + 1, i] = ls[24 + i]  # m_worldAngularVelocity
 
 
 @njit(cache=True)

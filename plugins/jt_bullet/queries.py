@@ -57,6 +57,21 @@ class SceneQueries:
         states = pb.getLinkStates(b, self._link_ids, **kw)
         return np.array([pos] + [s[0] for s in states]), np.array([orn] + [s[1] for s in states])
 
+    def link_velocities(self) -> tuple[np.ndarray, np.ndarray]:
+        """World linear and angular velocities ``(n_links + 1, 3)`` of the base and every link's
+        centre of mass, from the current joint velocities (PyBullet's getBaseVelocity and
+        getLinkStates(computeLinkVelocity=1); the links' rotation to the world is the one cached
+        at the last substep, as PyBullet reports it)."""
+        import pybullet as pb
+
+        kw, b = {"physicsClientId": self.client}, self.character.body_id
+        compiled = getattr(self, "_compiled", None)
+        if compiled:  # the same request and fields through the C API
+            return compiled.link_velocities()
+        lin, ang = pb.getBaseVelocity(b, **kw)
+        states = pb.getLinkStates(b, self._link_ids, computeLinkVelocity=1, **kw)
+        return np.array([lin] + [s[6] for s in states]), np.array([ang] + [s[7] for s in states])
+
     def link_index(self, name: str) -> int:
         """PyBullet index of the link called ``name``, else of the joint called ``name`` (its child
         link); -1 for ``"base"`` / ``"root"`` (when no link or joint has that name).

@@ -156,6 +156,12 @@ class Simulator(Plugin, abc.ABC):
         every link, base first, world frame, in one batched read."""
         raise NotImplementedError
 
+    def link_velocities(self) -> tuple["np.ndarray", "np.ndarray"]:
+        """World linear and angular velocities ``(n_links + 1, 3)`` of every link's centre of mass,
+        base first, now (optional: an observation that asks for them, e.g. ``task=spacetime
+        task.velocities=links``, needs it)."""
+        raise NotImplementedError
+
     def link_index(self, name: str) -> int:
         """The index of a character link by name, for ``link_pose``, ``aabb`` and contacts.
 

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from toolkit.interfaces.simulator import BASE, ContactRule, Watch
+from toolkit.interfaces.simulator import BASE, ContactRule, Simulator, Watch
 
 
 def run_state() -> tuple[np.ndarray, np.ndarray]:
@@ -105,6 +105,35 @@ class SimulatorContract:
         np.testing.assert_allclose(sim.com(), m @ pos / m.sum(), atol=1e-12)
         q, _ = sim.state()
         np.testing.assert_allclose(pos[0], q[:3], atol=1e-9)  # row 0 is the base
+
+    def test_link_velocities_are_the_links_motion(self, sim):
+        """Base row = the base's generalised velocity; a held pose falling freely moves every link
+        with the base; a running pose's link velocities match its links' central differences."""
+        if type(sim).link_velocities is Simulator.link_velocities:
+            pytest.skip("link_velocities is optional")
+        q, _ = self._lifted(sim, 0.5)
+        for _ in range(10):
+            sim.step(q, n_substeps=1)
+        lin, ang = sim.link_velocities()
+        _, qd = sim.state()
+        assert lin.shape == ang.shape == (sim.n_links + 1, 3)
+        np.testing.assert_allclose(lin[0], qd[:3], atol=1e-9)
+        np.testing.assert_allclose(ang[0], qd[3:6], atol=1e-9)
+        assert lin[0, 1] < -0.1  # falling
+        np.testing.assert_allclose(lin, np.broadcast_to(qd[:3], lin.shape), atol=2e-3)
+        np.testing.assert_allclose(ang, 0.0, atol=2e-2)
+        q, qd = run_state()
+        q = q.copy()
+        q[1] += 0.5
+        sim.reset(q, qd)
+        sim.step(q, n_substeps=2)  # link frames read after a step are the engine's own
+        dt = 1.0 / sim.sim_hz
+        p0 = sim.link_states()[0]
+        sim.step(q, n_substeps=1)
+        v1 = sim.link_velocities()[0]
+        sim.step(q, n_substeps=1)
+        fd = (sim.link_states()[0] - p0) / (2 * dt)
+        assert np.abs(fd - v1).max() < 0.05 * np.abs(v1).max() + 0.05
 
     def test_link_index_and_link_pose_are_forward_kinematics_of_the_reset_state(self, sim):
         from toolkit.errors import JtError

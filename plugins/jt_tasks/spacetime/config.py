@@ -47,6 +47,8 @@ class SpacetimeConfig(PolicyConfig):
     """A looping clip's next cycle carries on its heading change (the walk turns 0.12 rad per cycle), so the reference is where a character tracking the clip goes (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam)."""
     root_orientation: str = "world"
     """Frame of the root's orientation in the observation: world, the reference cycle's frame (the world frame when cycles do not turn), so the policy sees the heading the bounds hold (002 §4.1: every kinematic quantity in the motion-direction frame except the root orientation; authors' code: use_global_root_ori); heading: in the root's own heading frame like the other links (jt before 2026-12, which hides the heading drift that ends the walk by its lateral CoM bound)."""
+    velocities: str = "joints"
+    """Velocities in the observation after the root's: joints, the joint velocities (ours; 148-D on the humanoid); links, every link's centre-of-mass linear and angular velocity in the heading frame (002 §4.1 "linear velocity v and angular velocity ω of each link"; 210-D, the authors' 197-D state plus the massless base row jt's pose block carries besides the pelvis)."""
     ffc_lead: float = 0.0
     """Control steps by which the FFC's reference pose leads the control step's start (002 and the authors' code: 0, the pose at the start of the step held over its substeps)."""
     ffc_velocity: bool = False
@@ -114,6 +116,7 @@ class SpacetimeConfig(PolicyConfig):
         require(self.heading_axis in (None, "x", "z"), "task.heading_axis", self.heading_axis, "x or z (null: per clip)")
         require(self.root_orientation in ("world", "heading"), "task.root_orientation", self.root_orientation,
                 "world or heading")
+        require(self.velocities in ("joints", "links"), "task.velocities", self.velocities, "joints or links")
         require(self.termination in ("bounds", "contact"), "task.termination", self.termination,
                 "bounds (002 §3.2) or contact (the DeepMimic baseline)")
         com = list(self.com_width) if isinstance(self.com_width, (list, tuple)) else self.com_width

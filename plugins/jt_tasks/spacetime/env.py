@@ -30,7 +30,9 @@
 Observation ``(obs_dim,)`` float32 (after the authors' 197-D one, research notes): the clip phase,
 root height, the base's and every link's centre of mass relative to the ground-projected root and
 their orientations, in the heading frame, the root's linear and angular velocity in the heading
-frame and the joint velocities.
+frame and the joint velocities (148-D), or with ``velocities=links`` every link's linear and
+angular velocity in the heading frame (210-D: 002 §4.1 and the authors' 197-D state, plus the
+massless base's row).
 """
 
 from __future__ import annotations
@@ -50,6 +52,8 @@ from jt_tasks.spacetime.reference import END_EFFECTORS, SpacetimeReference, head
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 
+_NO_LINKS = np.zeros((0, 3))  #: observe's link velocities with task.velocities=joints
+
 
 @dataclasses.dataclass
 class SpacetimeSpec:
@@ -64,6 +68,7 @@ class SpacetimeSpec:
     ground_clearance: float = default_of(_C, "ground_clearance")
     cycle_turn: bool = default_of(_C, "cycle_turn")
     root_orientation: str = default_of(_C, "root_orientation")
+    velocities: str = default_of(_C, "velocities")
     ffc_lead: float = default_of(_C, "ffc_lead")
     ffc_velocity: bool = default_of(_C, "ffc_velocity")
     termination: str = default_of(_C, "termination")
@@ -259,9 +264,14 @@ class SpacetimeEnv(CharacterEnv):
 
         q, qd = self.sim.state()
         pos, orn = self.sim.link_states()
-        obs = np.empty(2 + 7 * len(pos) + len(qd), dtype=np.float32)
+        if self.spec_.velocities == "links":
+            lin, ang = self.sim.link_velocities()
+            obs = np.empty(2 + 13 * len(pos), dtype=np.float32)
+        else:
+            lin = ang = _NO_LINKS
+            obs = np.empty(2 + 7 * len(pos) + len(qd), dtype=np.float32)
         half = -0.5 * self.ref.cycle_yaw(self.clip_time)
-        kernels.observe(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), pos, orn,
+        kernels.observe(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), pos, orn, lin, ang,
                         self.ref.phase(self.clip_time), self.axis == "z", self.spec_.root_orientation == "world",
                         math.sin(half), math.cos(half), obs)
         return obs

@@ -125,14 +125,16 @@ def _finite(x: float) -> float:
 
 
 @njit(cache=True)
-def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, phase: float, axis_z: bool,
-            root_world: bool, fy: float, fw: float, out: np.ndarray) -> None:
-    """The observation (``SpacetimeEnv.observe``) into ``out`` ``(2 + 7 n + n_dof,)`` float32:
-    phase, root height, link CoMs ``pos`` ``(n, 3)`` relative to the ground-projected root and
-    orientations ``orn`` ``(n, 4)`` (w >= 0) in the heading frame, root velocities in the heading
-    frame, joint velocities; NaN and inf as 0. With ``root_world`` the root's orientation (link 0)
-    is taken in the frame ``(0, fy, 0, fw)`` (the inverse of the reference cycle's yaw; the world
-    frame when cycles do not turn) instead of the heading frame (002 §4.1)."""
+def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, lin: np.ndarray, ang: np.ndarray,
+            phase: float, axis_z: bool, root_world: bool, fy: float, fw: float, out: np.ndarray) -> None:
+    """The observation (``SpacetimeEnv.observe``) into ``out`` float32: phase, root height, link
+    CoMs ``pos`` ``(n, 3)`` relative to the ground-projected root and orientations ``orn``
+    ``(n, 4)`` (w >= 0) in the heading frame, root velocities in the heading frame, then either the
+    joint velocities (``lin`` empty: ``(2 + 7 n + n_dof,)``) or every other link's CoM linear and
+    angular velocity ``lin``, ``ang`` ``(n, 3)`` (world; row 0, the root, unused) in the heading
+    frame (``(2 + 13 n,)``, 002 §4.1); NaN and inf as 0. With ``root_world`` the root's orientation
+    (link 0) is taken in the frame ``(0, fy, 0, fw)`` (the inverse of the reference cycle's yaw;
+    the world frame when cycles do not turn) instead of the heading frame (002 §4.1)."""
     ix, iy, iz, iw = heading_inverse(q[3], q[4], q[5], q[6], axis_z)
     n = pos.shape[0]
     out[0], out[1] = _finite(phase), _finite(q[1])
@@ -155,8 +157,16 @@ def observe(q: np.ndarray, qd: np.ndarray, pos: np.ndarray, orn: np.ndarray, pha
         vx, vy, vz = _rotate(ix, iy, iz, iw, qd[3 * b], qd[3 * b + 1], qd[3 * b + 2])
         out[o + 3 * b], out[o + 3 * b + 1], out[o + 3 * b + 2] = _finite(vx), _finite(vy), _finite(vz)
     o += 6
-    for j in range(6, qd.shape[0]):
-        out[o + j - 6] = _finite(qd[j])
+    if lin.shape[0] == 0:
+        for j in range(6, qd.shape[0]):
+            out[o + j - 6] = _finite(qd[j])
+        return
+    for l in range(1, n):
+        vx, vy, vz = _rotate(ix, iy, iz, iw, lin[l, 0], lin[l, 1], lin[l, 2])
+        wx, wy, wz = _rotate(ix, iy, iz, iw, ang[l, 0], ang[l, 1], ang[l, 2])
+        k = o + 6 * (l - 1)
+        out[k], out[k + 1], out[k + 2] = _finite(vx), _finite(vy), _finite(vz)
+        out[k + 3], out[k + 4], out[k + 5] = _finite(wx), _finite(wy), _finite(wz)
 
 
 @njit(cache=True)

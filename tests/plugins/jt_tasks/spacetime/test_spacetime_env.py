@@ -294,3 +294,27 @@ def test_a_turned_cycle_observes_the_root_in_that_cycles_frame():
         assert e.ref.cycle_yaw(e.clip_time) == pytest.approx(2.0 * e.ref.turn)
     finally:
         e.close()
+
+
+def test_link_velocity_observation_is_the_papers_state():
+    """task.velocities=links: 2 + 13 x 16 = 210 entries (002 §4.1; the authors' 197 without the
+    massless base row jt's pose block carries besides the pelvis); the pose part is the joints
+    observation's, the link velocities are the simulator's rotated into the heading frame."""
+    from toolkit.motion import rotations as rot
+
+    joints, links = make_env(clip="walk"), make_env(clip="walk", velocities="links")
+    o_j, _ = joints.reset(seed=0, options={"phase": 0.3})
+    o_l, _ = links.reset(seed=0, options={"phase": 0.3})
+    n = links.n_links + 1
+    assert o_l.shape == (2 + 13 * n,) and o_j.shape == (2 + 7 * n + len(joints.sim.state()[1]),)
+    np.testing.assert_array_equal(o_l[:2 + 7 * n + 6], o_j[:2 + 7 * n + 6])
+    lin, ang = links.sim.link_velocities()
+    got = o_l[2 + 7 * n + 6:].reshape(n - 1, 6)
+    inv = links.heading_inverse()
+    for l in range(1, n):
+        np.testing.assert_allclose(got[l - 1, :3], rot.quat_rotate(inv, lin[l]), atol=1e-5)
+        np.testing.assert_allclose(got[l - 1, 3:], rot.quat_rotate(inv, ang[l]), atol=1e-5)
+    assert np.abs(got[:, :3]).max() > 0.1  # the walk's links move
+    for _ in range(3):
+        o_l, *_ = links.step(np.zeros(links.action_space.shape, dtype=np.float32))
+    assert o_l.shape == (2 + 13 * n,) and np.all(np.isfinite(o_l))
