@@ -31,11 +31,13 @@ from typing import Any, Optional
 import numpy as np
 
 from jt_tasks.getup import features as F
+from jt_tasks.getup.config import GetupConfig as _C
 from jt_tasks.getup import kernels
 from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.initial import clip_pose, pick_curve
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
 from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.spec import default_of
 from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
 
@@ -45,24 +47,26 @@ LOOKAHEAD = np.array([0.0, 0.1, 0.2, 0.3])  #: s, curve targets in the state (00
 
 @dataclasses.dataclass
 class GetupSpec:
-    """Everything a get-up environment needs, as plain picklable data (``GetupConfig`` documents it)."""
+    """Everything a get-up environment needs, as plain picklable data. A field named as one of
+    ``GetupConfig``'s has its default from there (``GetupConfig`` documents it); the rest are
+    the task's resolved values (``jt_tasks.policy.spec``)."""
 
     curves: list = dataclasses.field(default_factory=list)  # FeatureCurve.to_dict() each
     fallen: list = dataclasses.field(default_factory=list)  # initial.fallen_states() entries
     reward: dict = dataclasses.field(default_factory=dict)  # {"terms": {name: params}}
-    natural_terms: tuple = ("naturalness",)
-    t_stand: float = 3.0
-    p_standing: float = 0.1
-    p_fallen: float = 0.3
-    curve_match_deg: float = 30.0
-    r_task_min: float = 0.1
-    sustain: float = 0.3
-    head_grace: float = 1.0
-    success_height: float = 0.8
-    success_window: float = 1.0
-    heightmap_n: int = 5
-    heightmap_spacing: float = 0.25
-    terrain: dict = dataclasses.field(default_factory=dict)  # terrain.TerrainSpec.to_dict(); {}: flat only
+    natural_terms: list = default_of(_C, "natural_terms")
+    t_stand: float = default_of(_C, "t_stand")
+    p_standing: float = default_of(_C, "p_standing")
+    p_fallen: float = default_of(_C, "p_fallen")
+    curve_match_deg: float = default_of(_C, "curve_match_deg")
+    r_task_min: float = default_of(_C, "r_task_min")
+    sustain: float = default_of(_C, "sustain")
+    head_grace: float = default_of(_C, "head_grace")
+    success_height: float = default_of(_C, "success_height")
+    success_window: float = default_of(_C, "success_window")
+    heightmap_n: int = default_of(_C, "heightmap_n")
+    heightmap_spacing: float = default_of(_C, "heightmap_spacing")
+    terrain: dict = dataclasses.field(default_factory=dict)  # resolved: TerrainSpec.to_dict(); {}: flat only
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
 

@@ -108,6 +108,7 @@ class GetupTask(PolicyTask):
 
     def env_spec(self, point: dict[str, float]) -> Any:
         from jt_tasks.getup.env import GetupSpec
+        from jt_tasks.policy.spec import spec_of
 
         p = self.params
         sim, action = self.character_groups()
@@ -115,13 +116,8 @@ class GetupTask(PolicyTask):
             sim["sim"] = {**(sim.get("sim") or {}), "friction": float(p.friction)}
         scale = float(point.get("time_scale", p.time_scale))
         reward = plain(group_of(self.cfg, "reward")) or {}
-        return GetupSpec(curves=[c.to_dict() for c in self.curve_set(scale)], fallen=self.fallen(sim),
-                         reward=dict(reward), natural_terms=tuple(p.natural_terms), t_stand=p.t_stand,
-                         p_standing=p.p_standing, p_fallen=p.p_fallen, curve_match_deg=p.curve_match_deg,
-                         r_task_min=p.r_task_min, sustain=p.sustain, head_grace=p.head_grace,
-                         success_height=p.success_height, success_window=p.success_window,
-                         heightmap_n=p.heightmap_n, heightmap_spacing=p.heightmap_spacing,
-                         terrain=plain(p.terrain) if p.terrain else {}, sim=sim, action=action)
+        return spec_of(GetupSpec, p, curves=[c.to_dict() for c in self.curve_set(scale)], fallen=self.fallen(sim),
+                       reward=dict(reward), terrain=plain(p.terrain) if p.terrain else {}, sim=sim, action=action)
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Hooks:

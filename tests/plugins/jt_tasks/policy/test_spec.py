@@ -70,3 +70,17 @@ def test_every_user_value_reaches_the_spacetime_spec():
     for k, v in values.items():
         assert getattr(spec, k) == v, k
     assert spec.style == style
+
+
+def test_getup_spec_defaults_are_its_configs():
+    """The same for GetupSpec and GetupConfig; curves and terrain are resolved by the task (the
+    Config names the curves, the spec holds them; the spec's {} terrain is flat ground)."""
+    from jt_tasks.getup.config import GetupConfig
+    from jt_tasks.getup.env import GetupSpec
+    from jt_tasks.policy.spec import shared_fields
+
+    shared = set(shared_fields(GetupSpec, GetupConfig)) - {"curves", "terrain"}
+    assert {"t_stand", "natural_terms", "heightmap_spacing", "success_window"} <= shared
+    spec, cfg = GetupSpec(), GetupConfig()
+    for name in shared:
+        assert getattr(spec, name) == getattr(cfg, name), name
