@@ -38,26 +38,30 @@ from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat
 from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
 from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.spec import default_of
+from jt_tasks.runup.task import RunupConfig as _C
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 
 
 @dataclasses.dataclass
 class RunupSpec:
-    """Everything a run-up environment needs, as plain picklable data."""
+    """Everything a run-up environment needs, as plain picklable data. A field named as one of
+    ``RunupConfig``'s has its default from there (documented there); ``target`` is the task's
+    resolved take-off features (``jt_tasks.policy.spec``)."""
 
-    kind: str = "highjump"  # highjump (000 eq 13) | obstacle (000 eq 14)
-    target: dict = dataclasses.field(default_factory=dict)  # desired take-off features by name
-    omega_y: Optional[float] = 3.0  # high jump: fixed omega_y target (000 §6.1.1)
-    clip: str = "run"  # reference run (DeepMimic humanoid3d_run.txt)
-    foot: str = "right"  # take-off foot
-    n_strides: int = 2  # take-off-foot mid-supports up to the take-off (ours)
-    contact_tol: float = 0.06  # m: support-phase detection (jt_tasks.takeoff.state)
-    foot_clearance: float = 0.002  # m: take-off foot above the ground at take-off in the reference
-    check_every: int = 1  # substeps between contact checks
-    w_imitation: float = 0.7  # ours (DeepMimic's task examples use 0.7 / 0.3)
-    w_goal: float = 0.3  # ours
-    goal_steps: Optional[float] = None  # terminal multiplier of w_G r_G; None: the episode's steps
+    kind: str = default_of(_C, "kind")
+    target: dict = dataclasses.field(default_factory=dict)  # resolved: desired take-off features by name
+    omega_y: Optional[float] = default_of(_C, "omega_y")
+    clip: str = default_of(_C, "clip")
+    foot: str = default_of(_C, "foot")
+    n_strides: int = default_of(_C, "n_strides")
+    contact_tol: float = default_of(_C, "contact_tol")
+    foot_clearance: float = default_of(_C, "foot_clearance")
+    check_every: int = default_of(_C, "check_every")
+    w_imitation: float = default_of(_C, "w_imitation")
+    w_goal: float = default_of(_C, "w_goal")
+    goal_steps: Optional[float] = default_of(_C, "goal_steps")
     sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
 

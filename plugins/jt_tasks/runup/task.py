@@ -112,6 +112,7 @@ class RunupTask(PolicyTask):
 
     def env_spec(self, point: dict[str, float]) -> Any:
         """The ``RunupSpec`` for target features ``point`` (missing ones: the defaults)."""
+        from jt_tasks.policy.spec import spec_of
         from jt_tasks.runup.env import RunupSpec
 
         p = self.params
@@ -119,11 +120,7 @@ class RunupTask(PolicyTask):
         feats = {**defaults, **{k: float(v) for k, v in point.items()},
                  **{k: float(v) for k, v in (p.point or {}).items()}}
         sim, action = self.character_groups()
-        return RunupSpec(kind=p.kind, target={k: float(feats[k]) for k in self.feature_names},
-                         omega_y=p.omega_y, clip=p.clip, foot=p.foot, n_strides=p.n_strides,
-                         contact_tol=p.contact_tol, foot_clearance=p.foot_clearance,
-                         check_every=p.check_every, w_imitation=p.w_imitation, w_goal=p.w_goal,
-                         goal_steps=p.goal_steps, sim=sim, action=action)
+        return spec_of(RunupSpec, p, target={k: float(feats[k]) for k in self.feature_names}, sim=sim, action=action)
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Any:

@@ -84,3 +84,16 @@ def test_getup_spec_defaults_are_its_configs():
     spec, cfg = GetupSpec(), GetupConfig()
     for name in shared:
         assert getattr(spec, name) == getattr(cfg, name), name
+
+
+def test_runup_spec_defaults_are_its_configs():
+    """The same for RunupSpec and RunupConfig; target is the task's resolved take-off features."""
+    from jt_tasks.policy.spec import shared_fields
+    from jt_tasks.runup.env import RunupSpec
+    from jt_tasks.runup.task import RunupConfig
+
+    shared = set(shared_fields(RunupSpec, RunupConfig)) - {"target"}
+    assert {"kind", "omega_y", "clip", "w_goal", "goal_steps"} <= shared
+    spec, cfg = RunupSpec(), RunupConfig()
+    for name in shared:
+        assert getattr(spec, name) == getattr(cfg, name), name
