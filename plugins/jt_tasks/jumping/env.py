@@ -38,7 +38,9 @@ import numpy as np
 
 from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
+from jt_tasks.jumping.config import JumpConfig as _C
 from jt_tasks.policy.env import CharacterEnv
+from jt_tasks.policy.spec import default_of
 from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
 from toolkit.interfaces.simulator import ContactRule, Watch
 
@@ -47,21 +49,23 @@ HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index
 
 @dataclasses.dataclass
 class EnvSpec:
-    """Everything an environment needs, as plain picklable data."""
+    """Everything an environment needs, as plain picklable data. A field named as one of
+    ``JumpConfig``'s has its default from there (documented there); the rest are the task's
+    resolved values (``jt_tasks.policy.spec``)."""
 
     kind: str = "highjump"  # highjump | obstacle
     features: dict = dataclasses.field(default_factory=dict)  # take-off features by name
     suite: SuiteSpec = dataclasses.field(default_factory=SuiteSpec)
-    clip: str = "run"  # reference run (000 §6.1.1; the DeepMimic run clip)
-    foot: str = "right"  # take-off foot
-    omega_y: Optional[float] = 3.0  # fixed facing-frame omega_y (000 §6.1.1), None: keep / explored
-    v_y: Optional[float] = None  # imposed vertical root speed at take-off (jumping intention), None: the clip's
+    clip: str = default_of(_C, "clip")
+    foot: str = default_of(_C, "foot")
+    omega_y: Optional[float] = default_of(_C, "omega_y")  # the task's: None for the obstacle jump (explored)
+    v_y: Optional[float] = default_of(_C, "v_y")  # None: the clip's own take-off speed
     takeoff_file: str = ""  # a run-up's takeoff_state.h5 to start from instead of the clip frame (takeoff_source)
     foot_clearance: float = 0.002  # m between the take-off foot and the ground at reset (ours)
-    time_limit: float = 2.0  # s after take-off (000 §6.1)
-    safe_margin: float = 0.2  # m from the wall for a success (000 §6.1)
+    time_limit: float = default_of(_C, "time_limit")
+    safe_margin: float = default_of(_C, "safe_margin")
     control_hz: float = 10.0  # initial control rate (the curriculum changes it)
-    check_every: int = 1  # substeps between contact checks
+    check_every: int = default_of(_C, "check_every")
     sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
     reward_terms: dict = dataclasses.field(default_factory=dict)  # {term: params}

@@ -154,6 +154,7 @@ class JumpTask(PolicyTask):
         """The ``EnvSpec`` for take-off features ``point`` (missing ones: the defaults)."""
         from jt_tasks.jumping.env import EnvSpec
         from jt_tasks.jumping.scene import SuiteSpec
+        from jt_tasks.policy.spec import spec_of
 
         p, cfg = self.params, self.cfg
         feats = {**(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
@@ -165,11 +166,9 @@ class JumpTask(PolicyTask):
         terms = plain(group_of(cfg, "reward")).get("terms", {})
         init = self.stage2_init()
         pol = init.policy_features if init is not None else (p.policy_features or [])
-        return EnvSpec(kind=self.kind, features=feats, suite=suite, clip=p.clip, foot=p.foot,
-                       omega_y=p.omega_y if self.kind == "highjump" else None, v_y=p.v_y,
-                       takeoff_file=str(self.takeoff_file() or ""),
-                       time_limit=p.time_limit, safe_margin=p.safe_margin, check_every=p.check_every,
-                       sim=sim, action=action, reward_terms=terms,
+        return spec_of(EnvSpec, p, kind=self.kind, features=feats, suite=suite,
+                       omega_y=p.omega_y if self.kind == "highjump" else None,
+                       takeoff_file=str(self.takeoff_file() or ""), sim=sim, action=action, reward_terms=terms,
                        policy_features=[list(map(float, f)) for f in pol])
 
     def curriculum(self) -> Any:

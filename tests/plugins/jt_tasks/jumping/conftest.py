@@ -44,7 +44,8 @@ def make_spec(**kw):
     from jt_tasks.jumping.env import EnvSpec
 
     base = dict(features={"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.4},
-                sim={"spd": {"name": "df"}}, action={"name": "raw"}, reward_terms=dict(TERMS))
+                sim={"spd": {"name": "df"}}, action={"name": "raw"}, reward_terms=dict(TERMS),
+                v_y=None)  # the run clip's own take-off speed, as these tests were written for
     base.update(kw)
     return EnvSpec(**base)
 

@@ -97,3 +97,18 @@ def test_runup_spec_defaults_are_its_configs():
     spec, cfg = RunupSpec(), RunupConfig()
     for name in shared:
         assert getattr(spec, name) == getattr(cfg, name), name
+
+
+def test_jump_env_spec_defaults_are_its_configs():
+    """The same for the jumps' EnvSpec and JumpConfig (v_y was None in the spec, 2.06 m/s in the
+    Config); policy_features is the task's resolved Stage-2 list."""
+    from jt_tasks.jumping.config import JumpConfig
+    from jt_tasks.jumping.env import EnvSpec
+    from jt_tasks.policy.spec import shared_fields
+
+    shared = set(shared_fields(EnvSpec, JumpConfig)) - {"policy_features"}
+    assert {"clip", "foot", "omega_y", "v_y", "time_limit", "safe_margin", "check_every"} <= shared
+    spec, cfg = EnvSpec(), JumpConfig()
+    for name in shared:
+        assert getattr(spec, name) == getattr(cfg, name), name
+    assert spec.v_y == 2.06
