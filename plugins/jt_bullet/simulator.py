@@ -216,6 +216,11 @@ class BulletSimulator(SceneQueries, Simulator):
         """``sim.control_hz`` (Hz)."""
         return float(self.params.control_hz)
 
+    @property
+    def friction(self) -> float:
+        """``sim.friction``: the ground's and the character's lateral friction."""
+        return float(self.params.friction)
+
     def reset(self, q: np.ndarray, qd: np.ndarray) -> None:
         """Put the character in state ``(q, qd)`` (``toolkit.dynamics`` layout); time = 0."""
         self.io.reset(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))

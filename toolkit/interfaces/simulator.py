@@ -122,6 +122,11 @@ class Simulator(Plugin, abc.ABC):
         """Default control rate (Hz); ``step`` runs ``sim_hz / control_hz`` substeps unless told
         otherwise (a task with its own rate passes ``n_substeps``)."""
 
+    @property
+    def friction(self) -> float:
+        """Lateral friction of the ground (what scene geometry a task adds should use to match it)."""
+        raise NotImplementedError
+
     # ------------------------------------------------------------------ state and stepping
     @abc.abstractmethod
     def reset(self, q: "np.ndarray", qd: "np.ndarray") -> None:

@@ -75,6 +75,13 @@ class SimulatorContract:
         assert sim.sim_hz > 0 and sim.control_hz > 0
         assert sim.n_substeps == round(sim.sim_hz / sim.control_hz)
 
+    def test_declares_its_ground_friction(self):
+        s = self.make(friction=0.7)
+        try:
+            assert s.friction == pytest.approx(0.7)
+        finally:
+            s.close()
+
     def test_step_runs_its_substeps_and_advances_time(self, sim):
         q, qd = self._lifted(sim, 0.5)
         rec = sim.step(q)

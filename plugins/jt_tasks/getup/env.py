@@ -126,8 +126,7 @@ class GetupEnv(CharacterEnv):
         self.tspec = TerrainSpec.from_dict(spec.terrain) if spec.terrain else None
         self.ground_bodies = {int(self.sim.ground)}
         if self.tspec is not None:
-            friction = float((spec.sim.get("sim") or {}).get("friction", 1.0))
-            self.ground_bodies.update(add_terrain(self.sim, self.tspec, friction))
+            self.ground_bodies.update(add_terrain(self.sim, self.tspec, self.sim.friction))
         self.fallen_by_region: dict[int, list[int]] = {}
         for i, st in enumerate(spec.fallen):
             self.fallen_by_region.setdefault(int(st.get("region", 0)), []).append(i)

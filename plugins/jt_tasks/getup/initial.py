@@ -120,7 +120,7 @@ def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = S
     q_stand, _ = clip_pose("getup_facedown", False, frame=-1)
     tspec = T.TerrainSpec.from_dict(terrain) if terrain is not None and region > 0 else None
     if tspec is not None:
-        T.add_terrain(sim, tspec, float((sim_groups.get("sim") or {}).get("friction", 1.0)))
+        T.add_terrain(sim, tspec, sim.friction)
         where = T.sample_locations(tspec, int(region), n, np.random.default_rng([int(seed), int(region)]))
     out = []
     try:
