@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Optional
 
+from jt_tasks.getup.curves import REFERENCE
 from jt_tasks.getup.styles import STYLES as AUTHORED_STYLES
 from jt_tasks.getup.terrain import REGIONS, TerrainSpec
 from jt_tasks.policy.task import PolicyConfig
@@ -39,6 +40,10 @@ class GetupConfig(PolicyConfig):
     """Share of episodes starting standing (003 §5.2 "necessary"; the share is ours)."""
     p_fallen: float = 0.3
     """Share of episodes starting from a rag-doll state (003 §5.2; the share is ours); the rest start at the curve's clip's first pose (003 §5.5)."""
+    rsi: float = 0.0
+    """Share of clip starts that begin at a uniformly random time of the clip instead of its first pose, the curve's clock set to that time (reference state initialisation, Peng et al. 2018; ours, not 003: experiment=laptop, docs/getup.md)."""
+    start_noise: float = 0.0
+    """Rad, joint perturbation (``initial.perturb_joints``) of every training clip start (ours; 0 = the clip's pose as 003 §5.5)."""
     n_fallen: int = 8
     """Rag-doll states generated per evaluation (ours)."""
     fallen_styles: list[str] = dataclasses.field(default_factory=lambda: ["prone", "supine"])
@@ -75,8 +80,8 @@ class GetupConfig(PolicyConfig):
     """Height-map samples per side (003 §3.3.2: 5 x 5)."""
     heightmap_spacing: float = 0.25
     """M between height-map samples (003 §3.2: 25 cm over 1 m)."""
-    terrain: dict = dataclasses.field(default_factory=lambda: TerrainSpec().to_dict())
-    """The terrain world (003 §3.2, §5.4, Fig. 3; jt_tasks.getup.terrain): four size x size m regions flat/easy/medium/hard along x, each harder one half rough (1 m tiles, 003 §3.2; heights uniform in [0, roughness] m, ours) and half sloped (a triangle wave of slope_deg, the steepest 30° as 003 §6.5; the others ours), seeded; {} = flat ground only."""
+    terrain: Optional[dict] = dataclasses.field(default_factory=lambda: TerrainSpec().to_dict())
+    """The terrain world (003 §3.2, §5.4, Fig. 3; jt_tasks.getup.terrain): four size x size m regions flat/easy/medium/hard along x, each harder one half rough (1 m tiles, 003 §3.2; heights uniform in [0, roughness] m, ours) and half sloped (a triangle wave of slope_deg, the steepest 30° as 003 §6.5; the others ours), seeded; null = flat ground only (a mapping is merged into the default terrain, so {} changes nothing)."""
     train_regions: str = "curriculum"
     """Regions with training rag-doll states: curriculum (all four when curriculum=terrain, else flat only) or flat (ours)."""
     eval_regions: list[str] = dataclasses.field(default_factory=lambda: list(REGIONS))
@@ -91,6 +96,14 @@ class GetupConfig(PolicyConfig):
     """Curve of the deterministic rollout (from its clip's first pose)."""
     eval_episodes: int = 4
     """Deterministic evaluation get-ups (the rollout, then the other curves' clip starts and rag-doll states in turn) giving success_rate (ours)."""
+    eval_clip_starts: int = 0
+    """Deterministic get-ups from the clips' first poses with ``eval_start_noise`` (seeded, one seed per episode, the clip curves in turn) at the end of training: ``success_clip`` (issue 29's stage 1; ours; 0: none)."""
+    eval_start_noise: float = 0.05
+    """Rad, joint perturbation of those starts and of the evaluations during training (ours)."""
+    eval_every: int = 0
+    """PPO iterations between evaluations during training (0: none): ``eval_clip_during`` deterministic get-ups from perturbed clip starts, as ``(samples, success, got_up)`` rows in ``extra["eval_history"]`` (ours)."""
+    eval_clip_during: int = 8
+    """Deterministic get-ups per evaluation during training (the clip curves in turn)."""
     time_scale: float = 1.0
     """Default of the searched point: every curve's T times this (003 §4.3)."""
 
@@ -119,6 +132,16 @@ class GetupConfig(PolicyConfig):
                 f"must be one of task.curves ({', '.join(self.curves)})")
         require(self.eval_episodes >= 1, "task.eval_episodes", self.eval_episodes, "must be >= 1")
         require(self.n_fallen >= 0, "task.n_fallen", self.n_fallen, "must be >= 0")
+        require(finite(self.rsi) and 0.0 <= self.rsi <= 1.0, "task.rsi", self.rsi, "must be in [0, 1]")
+        for key in ("start_noise", "eval_start_noise"):
+            v = getattr(self, key)
+            require(finite(v) and 0.0 <= v <= 1.0, f"task.{key}", v, "must be a finite number in [0, 1] rad")
+        for key in ("eval_clip_starts", "eval_every", "eval_clip_during"):
+            v = getattr(self, key)
+            require(isinstance(v, int) and v >= 0, f"task.{key}", v, "must be an integer >= 0")
+        require(any(c in REFERENCE for c in self.curves) or not (self.eval_clip_starts or self.eval_every or self.rsi),
+                "task.curves", list(self.curves), "clip starts (task.rsi, task.eval_clip_starts, task.eval_every) "
+                f"need a reference curve ({', '.join(REFERENCE)})")
         for key in ("p_standing", "p_fallen"):
             v = getattr(self, key)
             require(finite(v) and 0.0 <= v <= 1.0, f"task.{key}", v, "must be in [0, 1]")
@@ -147,7 +170,7 @@ class GetupConfig(PolicyConfig):
         unknown = [r for r in self.eval_regions if r not in REGIONS]
         require(not unknown, "task.eval_regions", list(self.eval_regions), f"each one of {', '.join(REGIONS)}")
         require(bool(self.terrain) or all(r == "flat" for r in self.eval_regions), "task.eval_regions",
-                list(self.eval_regions), "only flat without a terrain (task.terrain={})")
+                list(self.eval_regions), "only flat without a terrain (task.terrain=null)")
         require(isinstance(self.eval_locations, int) and self.eval_locations >= 1, "task.eval_locations",
                 self.eval_locations, "an integer >= 1 (task.eval_regions=[] skips the Table 1 evaluation)")
         require(self.drop_hz is None or (finite(self.drop_hz) and self.drop_hz >= 30.0), "task.drop_hz", self.drop_hz,

@@ -34,7 +34,8 @@ from jt_tasks.getup import features as F
 from jt_tasks.getup.config import GetupConfig as _C
 from jt_tasks.getup import kernels
 from jt_tasks.getup.curves import FeatureCurve
-from jt_tasks.getup.initial import clip_pose, pick_curve
+from jt_tasks.getup.ground import lift_to_ground
+from jt_tasks.getup.initial import clip_pose, clip_state_at, perturb_joints, pick_curve
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
 from jt_tasks.policy.env import CharacterEnv
 from jt_tasks.policy.spec import default_of
@@ -58,6 +59,8 @@ class GetupSpec:
     t_stand: float = default_of(_C, "t_stand")
     p_standing: float = default_of(_C, "p_standing")
     p_fallen: float = default_of(_C, "p_fallen")
+    rsi: float = default_of(_C, "rsi")
+    start_noise: float = default_of(_C, "start_noise")
     curve_match_deg: float = default_of(_C, "curve_match_deg")
     r_task_min: float = default_of(_C, "r_task_min")
     sustain: float = default_of(_C, "sustain")
@@ -133,16 +136,22 @@ class GetupEnv(CharacterEnv):
         self._begin(0, "clip" if self.curves[0].clip else "standing", None)
 
     # ------------------------------------------------------------------ episodes
-    def _clip_start(self, c: FeatureCurve) -> tuple[np.ndarray, np.ndarray]:
+    def _clip_start(self, c: FeatureCurve, at: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The clip's state ``at`` s on the curve's clock (0: its first pose, memoised)."""
+        if at > 0.0:
+            return clip_state_at(c.clip, c.mirrored, at, c.duration)
         key = (c.clip, c.mirrored)
         if key not in self._clip_starts:
             self._clip_starts[key] = clip_pose(c.clip, c.mirrored, frame=0)
         return self._clip_starts[key]
 
-    def _begin(self, curve: int, kind: str, fallen: Optional[int], where: Optional[np.ndarray] = None) -> None:
+    def _begin(self, curve: int, kind: str, fallen: Optional[int], where: Optional[np.ndarray] = None,
+               at: float = 0.0, noise: float = 0.0, noise_rng: Optional[np.random.Generator] = None) -> None:
         c = self.curves[curve]
         if kind == "clip":
-            q, qd = self._clip_start(c)
+            q, qd = self._clip_start(c, at)
+            if noise > 0.0:  # a perturbed clip start, resting on the ground again
+                q = lift_to_ground(perturb_joints(q, noise_rng, noise))
         elif kind == "fallen":
             st = self.spec_.fallen[fallen]
             q, qd = np.asarray(st["q"], float), np.asarray(st["qd"], float)
@@ -155,7 +164,9 @@ class GetupEnv(CharacterEnv):
             self.sim.reset(np.array(q), np.array(qd))
         self.action_space_.reset(None)
         self.curve_index, self.curve, self.start_kind = curve, c, kind
-        self.t_offset = c.duration if kind == "standing" else 0.0  # standing: s = 1 from the start
+        # the curve's clock at the start: standing s = 1; a clip start inside the clip (rsi) its time
+        self.t_offset = c.duration if kind == "standing" else (float(at) if kind == "clip" else 0.0)
+        self.start_time = self.t_offset if kind == "clip" else 0.0
         self.t_end = c.duration + float(self.spec_.t_stand)
         self.watch = Watch(time_limit=self.t_end - self.t_offset, time_limit_outcome="truncate",
                            time_limit_reason="time limit")
@@ -187,8 +198,10 @@ class GetupEnv(CharacterEnv):
         """A new episode (003 §5.2, §5.4): a region among the unlocked ``0..terrain_level`` (all keep
         being visited), then on flat ground a standing, rag-doll or clip start, on irregular ground a
         standing start at a random location or a rag-doll state dropped there (clip poses are used on
-        flat terrain only, 003 §5.2). Options: ``kind``, ``curve`` (index or name), ``fallen`` (index
-        into the spec's states), ``region``."""
+        flat terrain only, 003 §5.2). A clip start begins at a random time of the clip with
+        probability ``rsi`` and is perturbed by ``start_noise`` rad. Options: ``kind``, ``curve``
+        (index or name), ``fallen`` (index into the spec's states), ``region``, ``at`` (s into a clip
+        start), ``noise`` and ``noise_seed`` (a clip start perturbed by ``noise`` rad, seeded)."""
         spec, rng = self.spec_, self.np_random
         opts = dict(options or {})
         kind, curve, fallen, region = opts.get("kind"), opts.get("curve"), opts.get("fallen"), opts.get("region")
@@ -229,10 +242,22 @@ class GetupEnv(CharacterEnv):
         where = None
         if kind == "standing" and region > 0:
             where = sample_locations(self.tspec, region, 1, rng)[0]
+        at, noise, noise_rng = 0.0, 0.0, None
+        if kind == "clip":  # no draw at the defaults (rsi = start_noise = 0): the same episodes as before
+            at = float(opts.get("at", 0.0) or 0.0)
+            if "at" not in opts and spec.rsi > 0.0 and float(rng.random()) < spec.rsi:
+                at = float(rng.uniform(0.0, self.curves[int(curve)].duration))
+            noise = float(opts.get("noise", spec.start_noise) or 0.0)
+            if noise > 0.0:
+                seed = opts.get("noise_seed")
+                noise_rng = rng if seed is None else np.random.default_rng(int(seed))
         self.region = region
-        self._begin(int(curve), kind, fallen, where)
-        return {"curve": float(self.curve_index), "start_kind": float(START_KINDS.index(kind)),
-                "terrain_level": float(self.region), "unlocked_level": float(self.terrain_level)}
+        self._begin(int(curve), kind, fallen, where, at, noise, noise_rng)
+        out = {"curve": float(self.curve_index), "start_kind": float(START_KINDS.index(kind)),
+               "terrain_level": float(self.region), "unlocked_level": float(self.terrain_level)}
+        if self.start_time > 0.0:  # a clip start inside the clip (rsi)
+            out["start_time"] = float(self.start_time)
+        return out
 
     # ------------------------------------------------------------------ measurements
     def _measure_now(self) -> dict[str, Any]:
@@ -368,6 +393,8 @@ class GetupEnv(CharacterEnv):
                                 "unlocked_level": float(self.terrain_level),
                                 "episode_time": float(self.sim.time), "steps": float(len(self.log)),
                                 "time_to_rise": float(self.rise_t) if not standing else math.nan}
+        if self.start_time > 0.0:  # a clip start inside the clip (rsi): not a get-up from the ground
+            info["start_time"] = float(self.start_time)
         if self.log:
             for k in self.log[0]:
                 if k.startswith("r"):

@@ -41,6 +41,24 @@ def clip_pose(clip: str, mirrored: bool = False, frame: int = 0, ground: float =
     return q, np.concatenate([v, w, jv])
 
 
+def clip_state_at(clip: str, mirrored: bool, t: float, duration: Optional[float] = None,
+                  ground: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(q (n_q,), qd (n_dof,))`` of a get-up clip ``t`` s into a curve of ``duration`` s (None:
+    the clip's own), the clip's time scaled to it and its velocities with it, resting
+    ``CLEARANCE`` above ``ground`` (a reference-state-initialisation start)."""
+    from jt_tasks.getup.curves import load_getup_clip
+    from jt_tasks.takeoff.state import reference_state
+
+    c = load_getup_clip(clip, mirrored)
+    length = float(c.times[-1] - c.times[0])
+    scale = 1.0 if not duration else length / float(duration)
+    tc = float(c.times[0]) + float(t) * scale
+    tc = min(max(tc, float(c.times[0]) + 1.0 / 120.0), float(c.times[-1]) - 1.0 / 120.0)
+    p, r, j, v, w, jv = reference_state(c, tc)
+    q = lift_to_ground(np.concatenate([p, r, j]), ground)
+    return q, np.concatenate([v, w, jv]) * scale
+
+
 def lay_down(q_stand: np.ndarray, style: str, yaw: float, height: float) -> np.ndarray:
     """The standing pose ``q_stand`` turned to lie ``prone`` or ``supine`` (about the world z axis of
     a character facing +x), then turned by ``yaw`` about +y, root at ``height``."""

@@ -28,8 +28,10 @@ from jt_tasks.getup.config import GetupConfig
 from jt_tasks.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
-#: per-iteration episode means (``early``: the share ended by 003 §5.3's early termination)
-HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate", "early")
+#: per-iteration means over episodes from the ground (clip first poses and rag-doll states; not
+#: standing starts, nor clip starts inside the clip): ``early`` is the share ended by 003 §5.3's
+#: early termination, ``success_clip`` / ``success_fallen`` the success of each start kind
+HISTORY = ("success", "got_up", "r_task_mean", "task_return_rate", "early", "success_clip", "success_fallen")
 
 
 class GetupTask(PolicyTask):
@@ -82,7 +84,7 @@ class GetupTask(PolicyTask):
         seed = p.fallen_seed if seed is None else int(seed)
         out = []
         for region in (self.train_regions() if regions is None else regions):
-            key = (repr(sim), repr(dict(p.terrain)), region, n, seed, tuple(p.fallen_styles), p.drop_height,
+            key = (repr(sim), repr(dict(p.terrain or {})), region, n, seed, tuple(p.fallen_styles), p.drop_height,
                    p.drop_perturb, p.ragdoll_kd, p.settle_max, p.rest_speed, p.drop_hz)
             cache = None if folder is None else \
                 Path(folder) / f"drops_{hashlib.sha1(repr(key).encode()).hexdigest()[:16]}.json"
@@ -91,7 +93,7 @@ class GetupTask(PolicyTask):
             if key not in _FALLEN:
                 _FALLEN[key] = fallen_states(sim, n, seed, tuple(p.fallen_styles), p.drop_height, p.drop_perturb,
                                              p.ragdoll_kd, p.settle_max, p.rest_speed,
-                                             terrain=dict(p.terrain) or None, region=region, sim_hz=p.drop_hz)
+                                             terrain=dict(p.terrain or {}) or None, region=region, sim_hz=p.drop_hz)
                 if cache is not None:  # written whole, then renamed: a kill never leaves half a file
                     tmp = cache.with_name(f"{cache.name}.tmp-{os.getpid()}")  # the store's temp-file pattern
                     tmp.write_text(json.dumps(_FALLEN[key]))
@@ -121,6 +123,12 @@ class GetupTask(PolicyTask):
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Hooks:
+        """The curriculum, the per-iteration history (``extra["getup_history"]``) and, every
+        ``eval_every`` iterations, deterministic get-ups from perturbed clip starts
+        (``stage1.ClipStartTraining``, ``extra["eval_history"]``)."""
+        import functools
+
+        from jt_tasks.getup.stage1 import ClipStartTraining
         from jt_tasks.policy.train import agent_config
         from toolkit import plugins
 
@@ -130,12 +138,17 @@ class GetupTask(PolicyTask):
         extra: dict[str, Any] = cur.bind({}) if cur is not None else {}
         progress = ctx.progress
 
+        def mean(eps: list, key: str) -> float:
+            return float(np.mean([e.get(key, 0.0) for e in eps])) if eps else math.nan
+
         def on_iteration(it: int, samples: int, stats: Any) -> dict[str, Any]:
             out = cur.on_iteration(it, samples, stats) if cur is not None else {}
             eps = getattr(stats, "episodes", []) or []
-            fallen_eps = [e for e in eps if e.get("start_kind", 0.0) != 2.0]
-            row = [float(samples)] + [float(np.mean([e.get(k, 0.0) for e in fallen_eps])) if fallen_eps else math.nan
-                                      for k in HISTORY]
+            ground = [e for e in eps if e.get("start_kind", 0.0) != 2.0 and not e.get("start_time", 0.0)]
+            by_kind = {k: [e for e in ground if e.get("start_kind", 0.0) == float(i)] for i, k in ((0, "clip"),
+                                                                                                   (1, "fallen"))}
+            row = [float(samples)] + [mean(ground, k) for k in HISTORY[:5]] + \
+                [mean(by_kind["clip"], "success"), mean(by_kind["fallen"], "success")]
             prev = np.asarray(extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
             prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
             extra["getup_history"] = np.vstack([prev, [row]])
@@ -143,7 +156,10 @@ class GetupTask(PolicyTask):
                 progress(min(samples / max(total, 1), 1.0), f"success {row[1]:.2f}")
             return out
 
-        return Hooks(on_iteration=on_iteration, extra=extra, state={"cur": cur})
+        p = self.params
+        hook = ClipStartTraining(functools.partial(self.env_class, spec, seed=ctx.seed), p.eval_clip_during,
+                                 p.eval_start_noise, p.eval_every, extra, on_iteration, progress, total)
+        return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook})
 
     def final_options(self, env: Any) -> Optional[dict]:
         return {"kind": "clip", "curve": self.params.eval_curve}
@@ -203,6 +219,15 @@ class GetupTask(PolicyTask):
             "samples": float(res.samples), "iterations": float(res.iterations),
             "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
         }
+        if p.eval_clip_starts > 0:  # issue 29's stage 1: perturbed clip starts, seeds never used in training
+            from jt_tasks.getup.stage1 import clip_start_success
+
+            env = self.env_class(spec, seed=0)
+            try:
+                st1 = clip_start_success(env, model, p.eval_clip_starts, p.eval_start_noise, seed=0)
+            finally:
+                env.close()
+            metrics["success_clip"], metrics["got_up_clip"] = st1["success"], st1["got_up"]
         if p.eval_regions:  # 003 §6.3, Table 1
             table = E.evaluate_regions(self, spec, model)
             figures = E.table_metrics(table)
@@ -226,6 +251,11 @@ class GetupTask(PolicyTask):
         history = {"mean_return": return_curve(trained)}
         for col, key in enumerate(HISTORY[:hist.shape[1] - 1], start=1):
             history[f"train_{key}"] = [(int(r[0]), float(r[col])) for r in hist if math.isfinite(r[col])]
+        rows = hooks.state["training"].history() if "training" in hooks.state else np.zeros((0, 3))
+        if len(rows):  # the deterministic get-ups from perturbed clip starts during training
+            history["eval_success_clip"] = [(int(r[0]), float(r[1])) for r in rows]
+            history["eval_got_up_clip"] = [(int(r[0]), float(r[2])) for r in rows]
+            metrics["best_success_clip_during"] = float(rows[:, 1].max())
         return Evaluation(metrics=metrics, history=history)
 
     def extra_artifacts(self, workdir: Path) -> list[str]:

@@ -40,3 +40,17 @@ def test_quick_preset_visits_every_region_on_a_fixed_schedule():
     c = cfg("quick")
     assert c.agent.total_samples // c.curriculum.fixed_every_samples >= 3  # hard unlocked before the end
     assert c.action.name == "raw" and c.task.eval_locations >= 5
+
+
+def test_laptop_preset_is_stage_one_on_flat_ground():
+    """experiment=laptop (issue 29): the 4 reference curves on flat ground, no curriculum, C-VAE
+    actions, obs normalisation, stage 1's 100 perturbed clip starts and Table 1's flat column,
+    episodes never cut by an iteration, the std/lr plateaus inside the budget, the cost stated."""
+    c = cfg("laptop")
+    a, t = c.agent, c.task
+    assert list(t.curves) == ["facedown", "facedown_mirror", "faceup", "faceup_mirror"]
+    assert t.terrain is None and "curriculum" not in c and list(t.eval_regions) == ["flat"]
+    assert c.action.name == "cvae" and a.obs_norm and t.eval_clip_starts == 100 and t.eval_locations == 100
+    assert a.samples_per_iteration / (a.n_workers * a.envs_per_worker) >= math.ceil((3.77 + 3.0) * 30)
+    assert max(s for s, _ in a.std_schedule) < a.total_samples and a.std_schedule[-1][1] == 0.3
+    assert "h on 2 cores" in c.cost
