@@ -37,6 +37,9 @@ def run_cmd(
 ) -> None:
     """Compose the config and run it (e.g. jt run task=highjump search=bds)."""
     from toolkit.config import compose, to_yaml
+    from toolkit.quiet import preload_quietly
+
+    preload_quietly()  # no native banner on the terminal, from composing on (workers do the same)
 
     ov = list(overrides or [])
     resume = [o.split("=", 1)[1] for o in ov if o.startswith("resume=")]
@@ -107,6 +110,9 @@ def compare_cmd(
 ) -> None:
     """Run a grid of variants over seeds and tabulate key metrics (mean ± std)."""
     from toolkit.execution.compare import compare, compare_runs
+    from toolkit.quiet import preload_quietly
+
+    preload_quietly()
 
     extra_runs = [o for o in (overrides or []) if "=" not in o] if runs else []
     if runs:

@@ -36,3 +36,23 @@ def native_stderr_silenced() -> Iterator[None]:
         os.dup2(saved[1], 2)
         for fd in (*saved, devnull):
             os.close(fd)
+
+
+#: Native modules that print a banner from C when first imported (PyBullet's ``pybullet build
+#: time: ...`` on stdout): names only, never imported here unless installed and asked for.
+NOISY_IMPORTS = ("pybullet",)
+
+
+def preload_quietly(names: tuple[str, ...] = NOISY_IMPORTS) -> None:
+    """Import each of ``names`` that is installed and not yet imported with C-level output silenced,
+    so that its banner never reaches a terminal (the CLI's working commands and every worker
+    process of the local executor call this first; later imports find the module loaded).
+    ``JT_VERBOSE_NATIVE=1`` shows the banners."""
+    import importlib
+    import importlib.util
+
+    for name in names:
+        if name in sys.modules or importlib.util.find_spec(name) is None:
+            continue
+        with native_stderr_silenced():
+            importlib.import_module(name)

@@ -80,15 +80,21 @@ def _die_with_parent(parent_pid: Optional[int], pdeathsig: bool) -> None:
 
 
 def _worker_init(parent_pid: Optional[int], pdeathsig: bool) -> None:
-    """Pool worker initializer: die with the driver, then one BLAS/torch thread."""
+    """Pool worker initializer: die with the driver, one BLAS/torch thread, no native banners."""
+    from toolkit.quiet import preload_quietly
+
     _die_with_parent(parent_pid, pdeathsig)
     _limit_threads()
+    preload_quietly()
 
 
 def _actor_main(conn: Any, factory: Callable[..., Any], args: tuple, parent_pid: Optional[int] = None,
                 pdeathsig: bool = False) -> None:
+    from toolkit.quiet import preload_quietly
+
     _die_with_parent(parent_pid, pdeathsig)
     _limit_threads()
+    preload_quietly()
     try:
         obj = factory(*args)
         conn.send(("ok", None))

@@ -107,6 +107,8 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     task = task_cls(cfg)
     problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
     search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
+    if cfg.get("cost"):  # what the wait costs, before any work (a prior trained first included)
+        _log(f"jt: cost: {cfg.cost}")
     cfg = auto_prior.resolve(cfg, _train_prior)  # action.prior=auto: the store's own prior, trained on first use
     store = Store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)
@@ -136,8 +138,6 @@ def _drive(store: Store, cfg: Any, command: str, run_id: str, resumed: bool, tas
     workdir = store.workdir(run_id)
     hist_path = workdir / "search_history.h5"
     _log(f"jt: run {run_id} ({experiment}){' resumed' if resumed else ''}; store {store.root}")
-    if cfg.get("cost"):
-        _log(f"jt: cost: {cfg.cost}")
     try:
         history = History.load(hist_path, names)
         if resumed:

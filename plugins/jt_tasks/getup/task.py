@@ -153,7 +153,8 @@ class GetupTask(PolicyTask):
             prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
             extra["getup_history"] = np.vstack([prev, [row]])
             if progress is not None:
-                progress(min(samples / max(total, 1), 1.0), f"success {row[1]:.2f}")
+                shown = f"{row[1]:.2f}" if math.isfinite(row[1]) else "— (no episode from the ground ended yet)"
+                progress(min(samples / max(total, 1), 1.0), f"success {shown}")
             return out
 
         p = self.params
