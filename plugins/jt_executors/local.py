@@ -202,6 +202,7 @@ class LocalExecutor(Executor):
         self._method = str(params.start_method)
         self._pool: Optional[Any] = None
         self._pool_pdeathsig = False
+        self._manager: Optional[Any] = None
 
     @property
     def n_workers(self) -> int:
@@ -211,7 +212,7 @@ class LocalExecutor(Executor):
         return mp.get_context(self._method)
 
     def imap(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[tuple[int, Any]]:
-        if self._workers == 1 or len(items) <= 1:
+        if self.runs_inline(len(items)):
             for i, x in enumerate(items):
                 yield i, fn(x)
             return
@@ -243,7 +244,25 @@ class LocalExecutor(Executor):
             return InlineActors(factory, args)
         return _ProcessActors(self._context(), factory, args)
 
+    def runs_inline(self, n_items: int) -> bool:
+        """One worker, or at most one item: ``imap`` calls the function here."""
+        return self._workers == 1 or n_items <= 1
+
+    def progress_queue(self) -> Optional[Any]:
+        """A ``multiprocessing`` manager's queue, which pool workers reach (started on first use;
+        its server process dies with the driver, as the workers do)."""
+        if self._manager is None:
+            from multiprocessing.managers import SyncManager
+
+            manager = SyncManager(ctx=self._context())
+            manager.start(_die_with_parent, _guard_args(self._method))
+            self._manager, self._queue = manager, manager.Queue()
+        return self._queue
+
     def close(self) -> None:
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
+        if self._manager is not None:
+            self._manager.shutdown()
+            self._manager = None

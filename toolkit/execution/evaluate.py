@@ -26,13 +26,18 @@ class Job:
         config: the run config as a plain container (picklable).
         point: parameter values by name.
         ctx: where and how to run it (index, seed, workdir).
-        verbose: print progress lines to stderr (evaluations that run longer than ``QUIET_S``).
+        verbose: print progress lines to stderr (evaluations that run longer than ``QUIET_S``)
+            when there is no ``channel``.
+        channel: where progress goes, ``channel(index, fraction, message)``: the run's
+            ``progress.RunProgress.update`` in the driver's process, or a ``progress.Channel`` onto
+            the executor's queue in a worker.
     """
 
     config: dict
     point: dict[str, float]
     ctx: EvalContext
     verbose: bool = False
+    channel: Any = None
 
 
 def _task_for(config: dict) -> Any:
@@ -73,7 +78,11 @@ def run_job(job: Job) -> tuple[Evaluation, float]:
     seed_everything(job.ctx.seed)
     task = _task_for(job.config)
     ctx = job.ctx
-    if job.verbose and ctx.progress is None:
+    if ctx.progress is None and job.channel is not None:
+        import functools
+
+        ctx = dataclasses.replace(ctx, progress=functools.partial(job.channel, ctx.index))
+    elif job.verbose and ctx.progress is None:
         ctx = dataclasses.replace(ctx, progress=_printer(ctx.index))
     t0 = time.perf_counter()
     ev = task.evaluate(dict(job.point), ctx)

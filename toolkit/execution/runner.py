@@ -23,7 +23,7 @@ import numpy as np
 
 from toolkit import plugins
 from toolkit.errors import JtError
-from toolkit.execution import describe, lifecycle, provenance
+from toolkit.execution import describe, lifecycle, progress, provenance
 from toolkit.execution.evaluate import Job, run_job
 from toolkit.execution.history import History, Record
 from toolkit.execution.seeds import derive
@@ -198,48 +198,63 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
                  searcher: Any, history: History, names: list[str], problem: Any, nested: bool,
                  executor: Any, hist_path: Path, parent_name: str) -> list[str]:
     """Ask, evaluate, log and tell until the budget is spent; the files logged on the outer run
-    itself (by a searcher that is not ``nested``)."""
+    itself (by a searcher that is not ``nested``). Progress: one ``progress.RunProgress`` for the
+    run, fed directly by evaluations in this process and through the executor's queue by those in
+    its workers."""
     budget = int(cfg.search.budget)
     obj_names = list(problem.objective_names)
     parent_name = parent_name or store.get_run(run_id).info.run_name
     prefix = str(getattr(task, "curve_prefix", "train/"))
     on_outer: list[str] = []
-    while not searcher.finished() and len(history) < budget:
-        x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
-        if len(x) == 0:  # a task with no parameters still has one (empty) point
-            break
-        b, start = history.n_batches, len(history)
-        jobs, child_ids = [], []
-        for j, xi in enumerate(x):
-            idx = start + j
-            point = problem.space.to_dict(xi)
-            ctx = EvalContext(index=idx, seed=derive(int(cfg.seed), idx),
-                              workdir=store.workdir(run_id, f"eval_{idx:04d}"))
-            child = run_id
-            if nested:
-                child = store.start_run(experiment, run_name=f"eval-{idx:04d}", parent_run_id=run_id,
-                                        tags={"jt.eval_index": str(idx), "jt.seed": str(ctx.seed)})
-                store.log_params(child, {**point, "seed": ctx.seed})
-            child_ids.append(child)
-            jobs.append(Job(container, point, ctx, verbose=True))
-        evs: list[Optional[Evaluation]] = [None] * len(jobs)
-        for j, (ev, secs) in executor.imap(run_job, jobs):
-            evs[j] = ev
-            logged = _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs, prefix)
-            if not nested:
-                on_outer += logged
-            history.add(Record(start + j, b, x[j], ev, child_ids[j] if nested else ""))
-            if nested:
-                ctx = jobs[j].ctx
-                store.set_tags(child_ids[j], {describe.NOTE: describe.evaluation(
-                    ctx.index, parent_name, jobs[j].point, ctx.seed, ev.metrics, getattr(task, "key_metrics", ()),
-                    logged, ev.reason if ev.failed else "")})
-                store.end_run(child_ids[j], "FINISHED")
-            shown = ", ".join(f"{k}={v:.4g}" for k, v in list(ev.metrics.items())[:4])
-            _log(f"jt: [{len(history)}/{budget}] eval {start + j} in {secs:.1f}s"
-                 f"{' FAILED: ' + ev.reason if ev.failed else ''} {shown}")
-        history.save(hist_path)
-        searcher.tell(x, evs)
+    bar = progress.RunProgress(budget, len(history), f"task={experiment}")
+    pump = None
+    try:
+        while not searcher.finished() and len(history) < budget:
+            x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
+            if len(x) == 0:  # a task with no parameters still has one (empty) point
+                break
+            b, start = history.n_batches, len(history)
+            channel: Any = bar.update  # evaluations in this process report straight to the bar
+            if not executor.runs_inline(len(x)):  # in worker processes: through the executor's queue
+                q = executor.progress_queue()
+                channel = progress.Channel(q) if q is not None else None
+                if q is not None and pump is None:
+                    pump = bar.pump(q)
+            jobs, child_ids = [], []
+            for j, xi in enumerate(x):
+                idx = start + j
+                point = problem.space.to_dict(xi)
+                ctx = EvalContext(index=idx, seed=derive(int(cfg.seed), idx),
+                                  workdir=store.workdir(run_id, f"eval_{idx:04d}"))
+                child = run_id
+                if nested:
+                    child = store.start_run(experiment, run_name=f"eval-{idx:04d}", parent_run_id=run_id,
+                                            tags={"jt.eval_index": str(idx), "jt.seed": str(ctx.seed)})
+                    store.log_params(child, {**point, "seed": ctx.seed})
+                child_ids.append(child)
+                jobs.append(Job(container, point, ctx, verbose=True, channel=channel))
+            evs: list[Optional[Evaluation]] = [None] * len(jobs)
+            for j, (ev, secs) in executor.imap(run_job, jobs):
+                evs[j] = ev
+                logged = _log_evaluation(store, child_ids[j], ev, jobs[j].ctx.workdir, obj_names, secs, prefix)
+                if not nested:
+                    on_outer += logged
+                history.add(Record(start + j, b, x[j], ev, child_ids[j] if nested else ""))
+                if nested:
+                    ctx = jobs[j].ctx
+                    store.set_tags(child_ids[j], {describe.NOTE: describe.evaluation(
+                        ctx.index, parent_name, jobs[j].point, ctx.seed, ev.metrics,
+                        getattr(task, "key_metrics", ()), logged, ev.reason if ev.failed else "")})
+                    store.end_run(child_ids[j], "FINISHED")
+                shown = ", ".join(f"{k}={v:.4g}" for k, v in list(ev.metrics.items())[:4])
+                bar.finished(start + j, f"jt: [{len(history)}/{budget}] eval {start + j} in {secs:.1f}s"
+                                        f"{' FAILED: ' + ev.reason if ev.failed else ''} {shown}")
+            history.save(hist_path)
+            searcher.tell(x, evs)
+    finally:
+        if pump is not None:
+            pump.stop()
+        bar.close()
     return on_outer
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
-from typing import Any, Callable, ClassVar, Iterator, Sequence
+from typing import Any, Callable, ClassVar, Iterator, Optional, Sequence
 
 from toolkit.interfaces.plugin import Plugin
 
@@ -97,6 +97,17 @@ class Executor(Plugin, abc.ABC):
     def n_workers(self) -> int:
         """How many items run at once."""
         return 1
+
+    def runs_inline(self, n_items: int) -> bool:
+        """Whether ``imap`` over ``n_items`` items runs them in this process (default: no), so
+        that they may report to the driver by a plain call."""
+        return False
+
+    def progress_queue(self) -> Optional[Any]:
+        """A queue (``put_nowait``, ``get(timeout=)``) that work running in this executor's workers
+        can reach from there, to report progress to the driver; None (the default): none, and
+        long evaluations in workers print their own progress lines."""
+        return None
 
     def close(self) -> None:
         """Release workers."""

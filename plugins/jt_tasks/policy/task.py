@@ -97,6 +97,9 @@ class Hooks:
     """The task's own bookkeeping (e.g. the curriculum), for ``final_env`` and ``measure``."""
 
 
+TRAIN_SHARE = 0.9  #: the share of an evaluation's progress that training is; the rollouts and measures the rest
+
+
 class PolicyTask(Task):
     """Train a policy, then measure its deterministic rollout (the shared wiring of policy tasks)."""
 
@@ -174,6 +177,10 @@ class PolicyTask(Task):
         from toolkit.store import h5
 
         p, workdir = self.params, Path(ctx.workdir)
+        outer = ctx
+        if ctx.progress is not None:  # training is the first TRAIN_SHARE of the evaluation's progress
+            report = ctx.progress
+            ctx = dataclasses.replace(ctx, progress=lambda f, m="": report(TRAIN_SHARE * f, m))
         spec = self.env_spec(point)
         hooks = self.training(spec, ctx)
         spec = hooks.spec if hooks.spec is not None else spec
@@ -182,6 +189,7 @@ class PolicyTask(Task):
                                   hooks.extra, hooks.should_stop, hooks.warm_start,
                                   self._adopt_trained(workdir))
         model = load_policy(trained.checkpoint)
+        outer.report(TRAIN_SHARE, "final rollout")
         env = self.env_class(spec, seed=ctx.seed)
         try:
             self.final_env(env, hooks, trained)
@@ -196,7 +204,9 @@ class PolicyTask(Task):
             env.close()
         written = tr.save_motion(workdir, ro["frames"], p.filmstrip_frames, fps)
         h5.write(workdir / "rollout.h5", {"time": ro["time"], "root": ro["root"], "com": ro["com"], **data}, attrs)
+        outer.report(TRAIN_SHARE + 0.02, "measuring the trained policy")
         ev = self.measure(spec, ro, trained, hooks, workdir)
+        outer.report(1.0, "done")
         if ev.artifacts is None:
             ev.artifacts = [n for n in (tr.CHECKPOINT, "rollout.h5", *written) if (workdir / n).exists()] + \
                 self.extra_artifacts(workdir)
