@@ -36,8 +36,9 @@ class Camera:
 
 
 def render_frame(client: int, target: Sequence[float], width: int = 320, height: int = 240,
-                 camera: Camera | None = None) -> np.ndarray:
-    """One RGB frame ``(height, width, 3)`` uint8 from TinyRenderer, looking at ``target``."""
+                 camera: Camera | None = None, body: int | None = None) -> Any:
+    """One RGB frame ``(height, width, 3)`` uint8 from TinyRenderer, looking at ``target``; with
+    ``body``, ``(frame, mask)``: the pixels that show that body, ``(height, width)`` bool."""
     import pybullet as p
 
     cam = camera or Camera()
@@ -46,9 +47,13 @@ def render_frame(client: int, target: Sequence[float], width: int = 320, height:
         pitch=cam.pitch, roll=0.0, upAxisIndex=cam.up_axis, physicsClientId=client)
     proj = p.computeProjectionMatrixFOV(fov=cam.fov, aspect=width / height, nearVal=0.05, farVal=50.0,
                                         physicsClientId=client)
-    _, _, rgba, _, _ = p.getCameraImage(width, height, view, proj, renderer=p.ER_TINY_RENDERER,
-                                        physicsClientId=client)
-    return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
+    _, _, rgba, _, seg = p.getCameraImage(width, height, view, proj, renderer=p.ER_TINY_RENDERER,
+                                          physicsClientId=client)
+    rgb = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
+    if body is None:
+        return rgb
+    ids = np.asarray(seg, dtype=np.int64).reshape(height, width)
+    return rgb, (ids >= 0) & ((ids & ((1 << 24) - 1)) == int(body))
 
 
 def filmstrip(frames: Sequence[np.ndarray], columns: int = 0, gap: int = 2) -> np.ndarray:

@@ -311,9 +311,10 @@ class SceneQueries:
 
     # ------------------------------------------------------------------ output
     def render(self, width: int = 320, height: int = 240, camera: Any = None,
-               target: Optional[Sequence[float]] = None) -> np.ndarray:
+               target: Optional[Sequence[float]] = None, mask: bool = False) -> Any:
         """RGB frame ``(height, width, 3)`` uint8 by TinyRenderer, looking at ``target`` (default:
-        the root) with ``camera`` (default: the character's view, ``character.camera_*``)."""
+        the root) with ``camera`` (default: the character's view, ``character.camera_*``); with
+        ``mask``, ``(frame, character pixels (height, width) bool)``."""
         import pybullet as pb
 
         from jt_bullet.config import DEFAULT_CAMERA
@@ -328,7 +329,8 @@ class SceneQueries:
         if target is None:
             pos, _ = pb.getBasePositionAndOrientation(self.character.body_id, physicsClientId=self.client)
             target = [v if math.isfinite(v) else 0.0 for v in pos]
-        return render_frame(self.client, target, width, height, camera)
+        return render_frame(self.client, target, width, height, camera,
+                            self.character.body_id if mask else None)
 
     # ------------------------------------------------------------------ bullet-only extras
     @classmethod

@@ -246,9 +246,11 @@ class Simulator(Plugin, abc.ABC):
 
     # ------------------------------------------------------------------ output
     def render(self, width: int = 320, height: int = 240, camera: Any = None,
-               target: Optional[Sequence[float]] = None) -> "np.ndarray":
+               target: Optional[Sequence[float]] = None, mask: bool = False) -> Any:
         """RGB frame ``(height, width, 3)`` uint8, headless, looking at ``target`` (default: the
-        root) with ``camera`` (a ``toolkit.render.Camera``; default: the character's view)."""
+        root) with ``camera`` (a ``toolkit.render.Camera``; default: the character's view); with
+        ``mask``, ``(frame, character)``: also where the character is, ``(height, width)`` bool
+        (a picture's check that it shows the character)."""
         raise NotImplementedError
 
     def close(self) -> None:

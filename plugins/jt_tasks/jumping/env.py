@@ -78,14 +78,15 @@ class JumpEnv(CharacterEnv):
     #: distance (m) and pitch (deg) of the view along the bar (``render_frame``)
     CAMERA = {"distance": 3.5, "pitch": -8.0}
 
-    def render_frame(self, width: int, height: int) -> np.ndarray:
+    def render_frame(self, width: int, height: int, mask: bool = False) -> Any:
         """RGB frame ``(height, width, 3)`` uint8 looking along the bar (its wall edge-on, below the
-        athlete as the CoM crosses its plane): the side view of a clearance, as ``000`` Fig. 7."""
+        athlete as the CoM crosses its plane): the side view of a clearance, as ``000`` Fig. 7;
+        with ``mask``, also the character's pixels."""
         from toolkit.render import Camera
 
         along = self.suite.rotation()[:, 2]
         yaw = math.degrees(math.atan2(float(along[0]), float(along[2])))
-        return self.sim.render(width, height, Camera(yaw=yaw, **self.CAMERA))
+        return self.sim.render(width, height, Camera(yaw=yaw, **self.CAMERA), mask=mask)
 
     # ------------------------------------------------------------------ set-up (scene, initial state)
     def setup(self) -> None:

@@ -149,11 +149,12 @@ class CharacterEnv(gymnasium.Env):
         """RGB frame ``(240, 320, 3)`` uint8."""
         return self.render_frame(320, 240)
 
-    def render_frame(self, width: int, height: int) -> np.ndarray:
-        """RGB frame ``(height, width, 3)`` uint8 (the class's ``CAMERA``, else the simulator's view)."""
+    def render_frame(self, width: int, height: int, mask: bool = False) -> Any:
+        """RGB frame ``(height, width, 3)`` uint8 (the class's ``CAMERA``, else the simulator's
+        view); with ``mask``, ``(frame, character pixels (height, width) bool)``."""
         from toolkit.render import Camera
 
-        return self.sim.render(width, height, Camera(**self.CAMERA) if self.CAMERA else None)
+        return self.sim.render(width, height, Camera(**self.CAMERA) if self.CAMERA else None, mask=mask)
 
     def close(self) -> None:
         if getattr(self, "sim", None) is not None:

@@ -73,9 +73,9 @@ class PolicyConfig:
     filmstrip_frames: int = 8
     """Frames of the final deterministic rollout's filmstrip (0: no pictures); the GIF has every
     control step's frame."""
-    filmstrip_width: int = 160
+    filmstrip_width: int = 320
     """px per frame."""
-    filmstrip_height: int = 120
+    filmstrip_height: int = 240
     """px."""
     evaluate: str = ""
     """A trained policy to measure instead of training one: a run id (its best evaluation), a

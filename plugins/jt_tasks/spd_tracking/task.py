@@ -69,9 +69,9 @@ class SPDTrackingConfig:
     """1/dt of the rendered run; 0: the largest of rates_hz."""
     render_fps: float = 30.0
     """Frames per simulated second in the GIF."""
-    render_width: int = 240
-    """Frame width, px."""
-    render_height: int = 180
+    render_width: int = 320
+    """Frame width, px (at least 320: a picture shows the character at every budget)."""
+    render_height: int = 240
     """Frame height, px."""
     filmstrip_frames: int = 8
     """Frames in filmstrip.png."""

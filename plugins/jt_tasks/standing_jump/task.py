@@ -77,9 +77,9 @@ class StandingJumpTask(Task):
         """Jump.h5 per evaluation (CoM, head, angular momentum at 100 Hz; events)."""
         filmstrips: bool = True
         """Summarize: filmstrips of lowest/highest natural and highest supernatural (004 Fig. 9)."""
-        filmstrip_width: int = 160
-        """Px per frame."""
-        filmstrip_height: int = 240
+        filmstrip_width: int = 320
+        """Px per frame (at least 320: a picture shows the jumper at every budget)."""
+        filmstrip_height: int = 480
         """Px per frame."""
 
     def __init__(self, cfg: Any = None) -> None:
