@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import sys
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -55,6 +56,11 @@ def _cell(args: tuple[list[str], bool]) -> tuple[str, dict[str, float]]:
     command = "jt run " + " ".join(overrides)  # what reruns this cell alone
     if inner_serial:  # every executor's group takes workers (ExecutorKeys); 1: one at a time
         overrides = [*overrides, "executor.workers=1"]
+        # cells side by side in worker processes: plain progress lines (two live bars would
+        # overwrite each other on one terminal); a cell run in the driver draws its bar
+        import os
+
+        os.environ["JT_PROGRESS"] = "lines"
     res = run(compose(overrides), command=command)
     return res.run_id, res.metrics
 
@@ -131,8 +137,12 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
         parallel = executor.n_workers > 1 and len(cells) > 1
         results: list[Any] = [None] * len(cells)
         try:
+            done = 0
             for i, res in executor.imap(_cell, [(ov, parallel) for _, ov, _ in cells]):
                 results[i] = res
+                done += 1
+                print(f"jt: compare: cell {done}/{len(cells)} done ({' '.join(cells[i][1])})", file=sys.stderr,
+                      flush=True)
                 values, _, cell_cfg = cells[i]
                 variant = "·".join(f"{k}={v}" for k, v in zip(keys, values) if k != "seed")
                 name = store.unique_run_name(experiment, f"{variant + '·' if variant else ''}seed={cell_cfg.seed}")
