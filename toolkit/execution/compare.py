@@ -264,9 +264,12 @@ def _record(store: Any, run_id: str, per_cell: list[tuple[str, str, dict[str, fl
     names = {rid: store.get_run(rid).info.run_name for _, rid, _ in per_cell}
     note = "\n".join([
         f"**Comparison** of {label} ({len(per_cell)} runs): mean ± std over seeds.", "",
-        describe.table(["variant", "n", *keys, "runs"],
-                       [[r["variant"], r["n"], *(f"{r[k][0]:.4g} ± {r[k][1]:.2g}" for k in keys),
-                         ", ".join(names.get(x) or x for x in r["runs"])] for r in rows]), "",
+        # one row per metric, one column per variant: it stays a table in the UI's narrow
+        # description pane (a row per variant wrapped every cell once there were 5+ metrics)
+        describe.table(["metric", *(r["variant"] for r in rows)],
+                       [[k, *(f"{r[k][0]:.4g} ± {r[k][1]:.2g}" for r in rows)] for k in keys]
+                       + [["seeds (n)", *(r["n"] for r in rows)],
+                          ["runs", *(", ".join(names.get(x) or x for x in r["runs"]) for r in rows)]]), "",
         f"Reproduce: `{command}`", "",
         "Metrics: `<variant>/<metric>_mean` and `_std`; the bar chart is the artifact `compare.png`, "
         "the numbers `compare.h5`; the compared runs are this run's children."

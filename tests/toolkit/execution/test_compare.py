@@ -95,7 +95,9 @@ def test_the_comparison_run_reads_well(example_plugin, store_dir):
     assert [h.step for h in store.client.get_metric_history(res.run_id, "0.5/value_mean")] == [0]
     assert "value_mean" not in m  # no single key over steps mixing the variants
     note = tags["mlflow.note.content"]
-    assert "| variant | n | value | runs |" in note and "| task.centre=0.5 | 2 | 0.5 ± 0 |" in note
+    # a row per metric, a column per variant (readable in the UI's narrow description pane)
+    assert "| metric | task.centre=0.0 | task.centre=0.5 |" in note and "| value | 0 ± 0 | 0.5 ± 0 |" in note
+    assert "| seeds (n) | 2 | 2 |" in note
     assert "task.centre=0.5·seed=1" in note  # the children by name
     kid = store.get_run(tags["jt.compare.runs"].split(",")[-1])
     assert kid.data.tags["jt.command"] == f"jt run task=quadratic executor.workers=1 store={store_dir} " \
