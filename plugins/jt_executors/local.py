@@ -12,6 +12,7 @@ import time
 import traceback
 from typing import Any, Callable, Iterator, Optional, Sequence
 
+from toolkit.execution import stopping
 from toolkit.execution.actors import InlineActors
 from toolkit.interfaces import ActorGroup, Executor
 
@@ -232,7 +233,10 @@ class LocalExecutor(Executor):
         pending = set(futures)
         try:
             while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                done, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
+                if not done:
+                    stopping.check()  # a stop requested while the workers evaluate: they are ended below
+                    continue
                 for f in done:
                     yield futures[f], f.result()
         finally:
@@ -261,6 +265,9 @@ class LocalExecutor(Executor):
 
     def close(self) -> None:
         if self._pool is not None:
+            if stopping.requested() is not None:  # stopping: end the running evaluations, don't wait for them
+                for proc in list(getattr(self._pool, "_processes", {}).values()):
+                    proc.terminate()
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
         if self._manager is not None:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import signal
 import sys
 from pathlib import Path
 from typing import Any, Optional, Sequence
@@ -23,7 +22,7 @@ import numpy as np
 
 from toolkit import plugins
 from toolkit.errors import JtError
-from toolkit.execution import describe, lifecycle, progress, provenance
+from toolkit.execution import describe, lifecycle, progress, provenance, stopping
 from toolkit.execution.evaluate import Job, run_job
 from toolkit.execution.history import History, Record
 from toolkit.execution.seeds import derive
@@ -63,23 +62,7 @@ def _eval_metrics(ev: Evaluation, names: list[str]) -> dict[str, float]:
     return out
 
 
-class _Terminate:
-    """Turns SIGTERM into KeyboardInterrupt while a run is open, so it ends as KILLED."""
-
-    def __enter__(self) -> None:
-        self._old = signal.getsignal(signal.SIGTERM)
-
-        def handler(signum: int, frame: Any) -> None:
-            raise KeyboardInterrupt("terminated (SIGTERM)")
-
-        try:
-            signal.signal(signal.SIGTERM, handler)
-        except ValueError:  # not the main thread
-            self._old = None
-
-    def __exit__(self, *exc: Any) -> None:
-        if self._old is not None:
-            signal.signal(signal.SIGTERM, self._old)
+_Terminate = stopping.Terminate  #: SIGTERM: a stop at the next safe point (``stopping``)
 
 
 def _train_prior(store: Any, overrides: Sequence[str], tag: str) -> str:
@@ -152,6 +135,7 @@ def _drive(store: Store, cfg: Any, command: str, run_id: str, resumed: bool, tas
                                  names, problem, nested, executor, hist_path, cfg.get("run_name") or "")
         finally:
             executor.close()
+        stopping.check()  # a safe point: every evaluation is in the store, the summary not yet
         metrics, pictures, table = _finish(store, run_id, task, searcher, history, workdir, hist_path, nested)
         pictures += files  # search=single: the evaluation's own files are on this run
         note = describe.outer(cfg, command, metrics, getattr(task, "key_metrics", ()), pictures, nested,
@@ -159,6 +143,11 @@ def _drive(store: Store, cfg: Any, command: str, run_id: str, resumed: bool, tas
         store.set_tags(run_id, {describe.NOTE: note})
         store.end_run(run_id, "FINISHED")
     except KeyboardInterrupt as e:
+        try:  # evaluations it cut off: KILLED now (as a resume would), so nothing is left RUNNING
+            lifecycle.close_stale_children(store, run_id, experiment,
+                                           {r.index for r in History.load(hist_path, names).records})
+        except Exception:  # noqa: BLE001 - the resume closes them too; the run's own end comes first
+            pass
         store.end_run(run_id, "KILLED", str(e) or "interrupted (Ctrl-C)")
         _log(f"jt: run {run_id} interrupted; continue it with: jt run resume={run_id} store={store.root}")
         raise
@@ -210,6 +199,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
     pump = None
     try:
         while not searcher.finished() and len(history) < budget:
+            stopping.check()  # a safe point: between batches
             x = np.asarray(searcher.ask(min(int(searcher.batch_size), budget - len(history))), dtype=float)
             if len(x) == 0:  # a task with no parameters still has one (empty) point
                 break
@@ -249,6 +239,7 @@ def _search_loop(store: Store, cfg: Any, container: dict, run_id: str, experimen
                 shown = ", ".join(f"{k}={v:.4g}" for k, v in list(ev.metrics.items())[:4])
                 bar.finished(start + j, f"jt: [{len(history)}/{budget}] eval {start + j} in {secs:.1f}s"
                                         f"{' FAILED: ' + ev.reason if ev.failed else ''} {shown}")
+                stopping.check()  # a safe point: this evaluation is in the store
             history.save(hist_path)
             searcher.tell(x, evs)
     finally:

@@ -24,6 +24,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from toolkit.execution import stopping
 from toolkit.rl import checkpoint as ckpt
 from toolkit.rl.checkpoint import architecture_of, with_architecture
 from toolkit.rl.config import PPOConfig, scheduled
@@ -403,6 +404,7 @@ def train(
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)
             if path is not None and iteration % cfg.checkpoint_every == 0:
                 saved = save()
+            stopping.check()  # a safe point (SIGTERM): a resume repeats from the last checkpoint, bit for bit
             if should_stop is not None and should_stop():
                 break
         if path is not None:

@@ -41,6 +41,9 @@ def clip_start_options(curves: list, n: int, noise: float, seed: int = 0) -> lis
 
 def run_episode(env: Any, model: Any, options: dict) -> dict[str, Any]:
     """One deterministic episode from ``env.reset(seed=0, options)``; its final info."""
+    from toolkit.execution import stopping
+
+    stopping.check()  # a safe point (SIGTERM): between episodes
     obs, _ = env.reset(seed=0, options=options)
     done, info = False, {}
     while not done:

@@ -138,6 +138,9 @@ def rollout(env: Any, model: Any, record: Callable[[Any], dict], frames: int = 0
         ``return``, ``info`` (the last step's), ``frames`` (every rendered frame), ``steps`` and
         one array per recorded name, ``(n_steps + 1, ...)``.
     """
+    from toolkit.execution import stopping
+
+    stopping.check()  # a safe point (SIGTERM): between the episodes of a final evaluation
     obs, _ = env.reset(seed=0, options=options)
     rows: list[dict] = []
     imgs: list[np.ndarray] = []

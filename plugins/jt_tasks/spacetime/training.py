@@ -18,6 +18,8 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from toolkit.execution import stopping
+
 EVAL_KEY = "eval_history"
 
 
@@ -63,6 +65,7 @@ class SpacetimeTraining:
         out = []
         try:
             for phase in self.phases():
+                stopping.check()  # a safe point (SIGTERM): between the evaluation's episodes
                 obs, _ = env.reset(seed=0, options={**self.options, "phase": phase})
                 info: dict = {}
                 done, steps = False, 0

@@ -300,3 +300,69 @@ def test_a_terminated_comparison_ends_killed_with_nothing_left_running(example_p
     assert compares == ["KILLED"], rows
     cells = [s for n, s in rows.items() if not n.startswith("compare")]
     assert len(cells) == 2 and set(cells) <= {"KILLED", "FINISHED"}, rows  # the pool's cells end, killed or done
+
+
+def test_sigterm_at_seeded_moments_stops_at_a_safe_point(example_plugin, template_db, tmp_path):
+    """SIGTERM at 20 seeded moments of a real run (opening, evaluating, logging, saving the history,
+    summarising; issue 30): the handler only records the request and the run stops at its next safe
+    point (``toolkit.execution.stopping``), so each ends with exit 130 and the run KILLED (or, sent
+    after the end, exit 0 and FINISHED), never with an exception swallowed inside the handler or a
+    store write cut halfway: nothing RUNNING, and a resume finishes it as an uninterrupted run would."""
+    from toolkit.cli import _resume_config
+    from toolkit.execution.runner import run
+
+    rng = random.Random(2026)
+    reference = _reference(4, template_db, tmp_path)
+    outcomes = []
+    for k in range(20):
+        store = _new_store(template_db, tmp_path / f"s{k}")
+        proc = _jt(example_plugin, "run", *COMMON, "search.budget=4", "task.sleep=0.2", f"store={store}")
+        rid = _wait("the run's row", lambda: _outer_ids(store), every=0.002)[0]
+        time.sleep(rng.uniform(0.0, 1.6))
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+        assert "Exception ignored" not in err and "internal error" not in err and "Traceback" not in err, err
+        status = _status(store, rid)
+        outcomes.append((proc.returncode, status))
+        if proc.returncode == 0:
+            assert status == "FINISHED", err
+        else:
+            assert proc.returncode == 130 and status == "KILLED", (proc.returncode, status, err)
+            assert f"jt run resume={rid}" in err
+            assert _query(store, "select name from runs where status = 'RUNNING'") == []
+            run(_resume_config(rid, [f"store={store}"]))
+        _assert_consistent(store, rid, reference)
+    assert sum(rc == 130 for rc, _ in outcomes) >= 12, outcomes  # most signals arrived while it ran
+
+
+def test_sigterm_while_pool_workers_evaluate_ends_them_at_once(example_plugin, template_db, tmp_path):
+    """Two 30 s evaluations in the local executor's pool: SIGTERM stops the run within seconds (the
+    driver checks for the request while it waits, and ends the workers instead of waiting for
+    them), exit 130, the run and both evaluations KILLED."""
+    store = _new_store(template_db, tmp_path / "store")
+    proc = _jt(example_plugin, "run", "task=quadratic", "search=random", "search.batch=2", "search.budget=2",
+               "executor.workers=2", "task.sleep=30", f"store={store}")
+    rid = _wait("the run's row", lambda: _outer_ids(store))[0]
+    _wait("both evaluations", lambda: len(_query(store, "select name from runs where status = 'RUNNING' and "
+                                                      "name like 'eval-%'")) == 2)
+    time.sleep(1.0)
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert time.monotonic() - t0 < 15, "the run waited for its evaluations"
+    assert proc.returncode == 130 and _status(store, rid) == "KILLED", err
+    assert _query(store, "select name from runs where status = 'RUNNING'") == []
+
+
+def test_the_handler_only_records_the_request_and_a_second_one_raises():
+    from toolkit.execution import stopping
+
+    with stopping.Terminate():
+        os.kill(os.getpid(), signal.SIGTERM)  # delivered here, in the main thread: nothing raised
+        assert stopping.requested() == "terminated (SIGTERM)"
+        with pytest.raises(KeyboardInterrupt, match="SIGTERM"):
+            stopping.check()
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.5)  # the second signal raises where the main thread is
+    assert stopping.requested() is None  # cleared when the run's block ends
