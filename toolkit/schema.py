@@ -135,9 +135,39 @@ def check_node(where: str, cls: type, node: Any) -> None:
         obj = OmegaConf.to_object(node)
     except Exception as e:  # noqa: BLE001 - e.g. a missing mandatory value
         raise _schema_error(where, cls, e) from e
+    require_finite(where.split("=")[0], obj)
     check = getattr(obj, "check", None)
     if callable(check):
         check()
+
+
+def require_finite(where: str, obj: Any) -> None:
+    """Every number in a config object (its fields, lists and mappings, nested) is finite: NaN
+    never is, ±inf only in the fields its class names in ``NONFINITE_OK`` (e.g. a bound width
+    that ``.inf`` switches off).
+
+    Raises:
+        JtError: ``<group>.<key>=nan: must be a finite number`` (one line).
+    """
+    def walk(path: str, value: Any, inf_ok: bool) -> None:
+        if isinstance(value, bool) or value is None:
+            return
+        if isinstance(value, float):
+            if math.isnan(value) or (math.isinf(value) and not inf_ok):
+                what = "a number (not NaN)" if inf_ok else "a finite number"
+                raise JtError(f"{path}={value}: must be {what}")
+        elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+            allowed = set(getattr(type(value), "NONFINITE_OK", ()))
+            for f in dataclasses.fields(value):
+                walk(f"{path}.{f.name}", getattr(value, f.name), inf_ok or f.name in allowed)
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{path}.{k}", v, inf_ok)
+        elif isinstance(value, (list, tuple)):
+            for v in value:
+                walk(path, v, inf_ok)
+
+    walk(where, obj, False)
 
 
 def _schema_error(where: str, cls: type, e: BaseException) -> JtError:

@@ -90,12 +90,35 @@ def test_executor_workers_is_the_interface_s_key(monkeypatch):
 
 
 def test_an_experiment_a_task_has_no_preset_for_is_one_line_naming_its_experiments():
-    """``task=getup experiment=laptop`` used to run the task's defaults (the paper's 100 M samples)
-    without a word; now it is refused, naming the experiments getup has."""
+    """``task=getup experiment=table1`` (a spacetime preset) would run the task's defaults (the
+    paper's 100 M samples) without a word; it is refused, naming the experiments getup has."""
     from toolkit.errors import JtError
 
-    with pytest.raises(JtError, match=r"experiment=laptop: task=getup has no preset.*its experiments: default, paper, quick, smoke") as e:
-        compose(["task=getup", "experiment=laptop"])
+    with pytest.raises(JtError, match=r"experiment=table1: task=getup has no preset.*its experiments: default, laptop, paper, quick, smoke") as e:
+        compose(["task=getup", "experiment=table1"])
     assert "\n" not in str(e.value)
     assert compose(["task=getup", "experiment=quick"]).profile == "quick"
     assert compose(["task=getup"]).profile == "default"  # no experiment named: the task's defaults
+
+
+@pytest.mark.parametrize("override", ["character.kp=inf", "agent.policy_lr=nan", "sim.gravity=-inf",
+                                      "task.takeoff.v_z=nan", "task.time_scale=nan"])
+def test_a_number_that_is_not_finite_is_one_line(override):
+    """NaN and ±inf are refused at composition wherever a field does not say otherwise (issue 30)."""
+    from toolkit.config import compose
+    from toolkit.errors import JtError
+
+    task = "getup" if override.startswith("task.time_scale") else "highjump"
+    with pytest.raises(JtError, match=r"must be a finite number"):
+        compose([f"task={task}", "experiment=smoke", override])
+
+
+def test_inf_switches_a_spacetime_bound_off_but_nan_is_refused():
+    """task.widths / com_width take .inf (a channel off, 002 §5.3.1's style runs): NONFINITE_OK."""
+    from toolkit.config import compose
+    from toolkit.errors import JtError
+
+    cfg = compose(["task=spacetime", "experiment=smoke", "preset=style_cartwheel_low_energy"])
+    assert cfg.task.widths.orientation == float("inf")
+    with pytest.raises(JtError, match=r"task.com_width=nan: must be a number \(not NaN\)"):
+        compose(["task=spacetime", "experiment=smoke", "task.com_width=nan"])

@@ -6,7 +6,7 @@ the fields it shares with this from here (``jt_tasks.policy.spec``).
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Optional
+from typing import Any, ClassVar, Optional
 
 from jt_tasks.policy.task import PolicyConfig
 
@@ -14,6 +14,10 @@ from jt_tasks.policy.task import PolicyConfig
 @dataclasses.dataclass
 class SpacetimeConfig(PolicyConfig):
     """The ``task`` group of ``task=spacetime`` (every default with its source)."""
+
+    #: fields where .inf means "this bound is off" (every other number must be finite)
+    NONFINITE_OK: ClassVar[tuple[str, ...]] = ("com_width", "orientation_width", "end_effector_width", "widths",
+                                               "width_table")
 
     name: str = "spacetime"
     """Registry name."""
