@@ -122,3 +122,15 @@ def test_an_untrained_policy_does_not_get_up_from_clip_starts():
 def test_bad_values_are_one_line(override, match):
     with pytest.raises(JtError, match=match):
         make_task("task.eval_clip_starts=4", *override.split())
+
+
+def test_the_clip_tracked_without_feedback_does_not_get_up():
+    """What a policy must add (issue 29, jt_tasks.getup.study): PD targets set to the facedown clip's
+    poses, no policy, lift the neck off the ground (> 0.3 m) but never to a standing height
+    (0.8 x 1.35 m), and the character ends lying again."""
+    from jt_tasks.getup.study import open_loop_clip
+
+    from tests.plugins.jt_tasks.getup.getup_helpers import sim_groups
+
+    o = open_loop_clip("getup_facedown", sim_groups(), t_stand=1.0)
+    assert 0.3 < o["h_max"] < 0.8 * 1.35 and o["h_end"] < 0.3 and o["duration"] == pytest.approx(3.03, abs=0.01)
