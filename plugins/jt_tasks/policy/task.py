@@ -46,7 +46,7 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
     if prior and prior != "auto":  # it must exist before the run opens (auto: found or trained by the runner)
         from toolkit.priors.io import find_prior
 
-        store = group_of(cfg, "store")
+        store = str(group_of(action, "store") or "").strip() or group_of(cfg, "store")  # action.store first
         find_prior(prior, None if store is None else str(store), name)
     trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
 

@@ -100,3 +100,19 @@ def test_the_filter_without_learning_keeps_targets_smooth_and_natural(priors):
             env.close()
     assert out[0.2]["r_natural"] > 0.6 and out[1.0]["r_natural"] < 0.2  # measured: 0.83 vs 0.01
     assert out[1.0]["target_change"] > 3 * out[0.2]["target_change"]  # measured: 0.61 vs 0.09 rad
+
+
+def test_a_prior_named_by_run_id_is_looked_up_in_action_store(tmp_path):
+    """action.store=DIR is where a prior's run id is looked up (issue 30, item 4), not the run's own
+    store; without it, the run's own store is searched and the id is refused in one line."""
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    elsewhere = tmp_path / "priors"
+    rid = run(compose(["task=pose_prior", "action=cvae", "experiment=smoke", f"store={elsewhere}"])).run_id
+    mine = tmp_path / "mine"
+    cfg = compose(["task=getup", *FAST, "action=cvae", f"action.prior={rid}", f"action.store={elsewhere}",
+                   f"store={mine}"])
+    assert cfg.action.prior == rid
+    with pytest.raises(JtError, match="action.prior"):
+        compose(["task=getup", *FAST, "action=cvae", f"action.prior={rid}", f"store={mine}"])
