@@ -37,6 +37,17 @@ class TerrainCurriculum(IterationCurriculum):
         level_attr: str = "terrain_level"
         """Environment attribute: highest unlocked region; envs sample 0..level (jt; 003 §5.4 "revisits all unlocked regions")."""
 
+        def check(self) -> None:
+            """One ``JtError`` line at composition: regions named, once each; counts in range."""
+            from toolkit.schema import require
+
+            require(bool(self.regions) and len(set(self.regions)) == len(self.regions), "curriculum.regions",
+                    list(self.regions), "one or more region names, each once")
+            require(int(self.successes_to_unlock) >= 1, "curriculum.successes_to_unlock", self.successes_to_unlock,
+                    "must be >= 1")
+            require(int(self.fixed_every_samples) >= 0, "curriculum.fixed_every_samples", self.fixed_every_samples,
+                    "must be >= 0 (0: adaptive)")
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         p = self.params

@@ -117,6 +117,10 @@ class GetupConfig(PolicyConfig):
         require(self.n_control >= 4, "task.n_control", self.n_control, "a cubic B-spline needs >= 4 control points")
         require(self.extraction in ("sample", "lstsq"), "task.extraction", self.extraction, "sample or lstsq")
         require(bool(self.curves), "task.curves", self.curves, "needs at least one curve")
+        for name, spec in dict(self.authored).items():  # a curve's own duration, even where durations override it
+            d = dict(spec or {}).get("duration")
+            require(d is None or (finite(d) and float(d) > 0), f"task.authored.{name}.duration", d,
+                    "must be > 0 s")
         for d in self.authored_durations:
             require(finite(d) and float(d) > 0, "task.authored_durations", list(self.authored_durations),
                     "durations must be > 0 s")

@@ -47,6 +47,16 @@ class GetupTask(PolicyTask):
         """The humanoid (the curves and start poses come from its clips) and a prior for action=cvae/pvae."""
         require_humanoid_and_prior(cfg, "getup", "its curves and start poses come from the DeepMimic "
                                                "humanoid's get-up clips")
+        from toolkit.errors import JtError
+
+        from jt_tasks.getup.terrain import REGIONS
+
+        node = group_of(cfg, "curriculum")
+        if node is not None and str(node.get("name", "")) == "terrain":
+            regions = list(node.get("regions") or [])
+            if regions != list(REGIONS[:len(regions)]):
+                raise JtError(f"curriculum.regions={regions}: the get-up terrain's regions are {', '.join(REGIONS)}, "
+                              "in this order (a prefix of them, e.g. [flat, easy])")
 
     def problem(self) -> SearchProblem:
         return SearchProblem(space=Space((Param("time_scale", 0.5, 2.0, float(self.params.time_scale)),)))

@@ -105,3 +105,22 @@ def test_cvae_without_a_prior_is_one_line_error():
 
     with pytest.raises(JtError, match="needs a trained prior"):
         validate(compose(["task=getup", "action.prior="]))
+
+
+NINE = "[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.9, 1.3]"
+
+
+@pytest.mark.parametrize("override, match", [
+    ("curriculum.regions=[]", "one or more region names"),
+    ("curriculum.successes_to_unlock=0", "must be >= 1"),
+    ("curriculum.regions=[flat,lava]", "the get-up terrain's regions are flat, easy, medium, hard"),
+    (f"task.authored={{my: {{h: {NINE}, theta_x: {NINE}, theta_z: {NINE}, duration: -2}}}}",
+     "task.authored.my.duration=-2: must be > 0 s"),
+])
+def test_values_are_checked_before_the_run_opens(override, match):
+    """Values refused at composition, before a run row exists (issue 30, item 3)."""
+    from toolkit.config import compose
+
+    with pytest.raises(JtError, match=match) as e:
+        compose(["task=getup", "action=raw", "curriculum=terrain", override])
+    assert "\n" not in str(e.value)
