@@ -287,6 +287,8 @@ def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = (), run_checks_too
     from omegaconf import OmegaConf
 
     OmegaConf.set_struct(cfg, False)
+    if cfg.get("task") is None or "name" not in cfg.task:  # e.g. ~task: every run is a task's
+        raise JtError(f"a run needs a task: task=<name>; choose one of: {', '.join(plugins.names('task'))}")
     by_group: dict[str, list[tuple[str, Any]]] = {}
     for key, value in overrides:
         group, _, rest = key.partition(".")

@@ -31,6 +31,12 @@ CASES = [
     (["task=highjump", "character.joint_kp={nope: 150.0}"], r"character 'humanoid' has no movable joint 'nope'; joints: chest"),
     (["task=zdt1", "reward=highjump"], r"task=zdt1 does not read a reward group; drop the reward= choice"),
     (["task=standing_jump", "action=pvae"], r"task=standing_jump does not read an action group; drop action=pvae"),
+    # issue 30: values that ran (or failed after the run opened)
+    (["~task"], r"a run needs a task: task=<name>; choose one of: .*getup"),
+    (["task=spd_tracking", "task.rates_hz=[]"], r"task.rates_hz=\[\]: one or more rates > 0 Hz"),
+    (["task=spd_tracking", "task.duration=-1"], r"task.duration=-1.0: must be >= 0 s"),
+    (["task=getup", "action=raw", "task.terrain=null", "task.eval_regions=[flat,hard]"],
+     r"only flat without a terrain \(task.terrain=null\)"),
 ]
 
 
@@ -68,3 +74,12 @@ def test_a_searcher_that_does_not_fit_the_task_is_one_line_before_anything_runs(
     with pytest.raises(JtError, match=f"search={search} needs a task with"):
         run(compose(["task=highjump", f"search={search}", f"store={store}"]))
     assert not store.exists()
+
+
+def test_a_comparison_cannot_vary_its_store(tmp_path):
+    """--vary store=A,B (issue 30): one line, nothing written."""
+    from toolkit.execution.compare import compare
+
+    with pytest.raises(JtError, match=r"bad --vary 'store=.*': a comparison and its runs live in one store"):
+        compare(["task=zdt1", f"store={tmp_path / 's'}"], [f"store={tmp_path / 'a'},{tmp_path / 'b'}"], 1)
+    assert not any((tmp_path / n).exists() for n in ("s", "a", "b"))

@@ -44,6 +44,9 @@ def parse_vary(vary: Sequence[str]) -> list[tuple[str, list[str]]]:
             raise JtError(f"bad --vary '{v}': no values (expected KEY=a,b[,c])")
         if len(set(items)) != len(items):
             raise JtError(f"bad --vary '{v}': a value is repeated")
+        if key.strip() in ("store", "resume"):
+            raise JtError(f"bad --vary '{v}': a comparison and its runs live in one store and start fresh; "
+                          f"give store=PATH once (resume a cell with jt run resume=RUN_ID)")
         out.append((key.strip(), items))
     return out
 

@@ -78,6 +78,17 @@ class SPDTrackingConfig:
     wave: WaveParams = dataclasses.field(default_factory=WaveParams)
     """The snakes' travelling wave (ours; see jt_tasks.spd_tracking.motions)."""
 
+    def check(self) -> None:
+        """One ``JtError`` line at composition for a rate list, a duration or a timing set-up out of range."""
+        from toolkit.schema import require
+
+        require(bool(self.rates_hz) and all(float(r) > 0 for r in self.rates_hz), "task.rates_hz",
+                list(self.rates_hz), "one or more rates > 0 Hz")
+        require(float(self.duration) >= 0, "task.duration", self.duration, "must be >= 0 s (0: two cycles)")
+        for key in ("fps_rate_hz", "fps_duration", "render_rate_hz"):
+            require(float(getattr(self, key)) >= 0, f"task.{key}", getattr(self, key), "must be >= 0 (0: the default)")
+        require(int(self.fps_repeats) >= 1, "task.fps_repeats", self.fps_repeats, "must be >= 1")
+
 
 class SPDTrackingTask(Task):
     """Mocap tracking with SPD and a hand-of-God root over time steps: error, FPS, SPD share."""
