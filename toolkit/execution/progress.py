@@ -15,6 +15,7 @@ run in its worker processes; ``pump`` drains that queue on a thread of the drive
 
 from __future__ import annotations
 
+import math
 import os
 import queue as queue_mod
 import sys
@@ -43,6 +44,16 @@ def clock(seconds: float) -> str:
     h, m = divmod(s, 3600)
     m, s = divmod(m, 60)
     return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"
+
+
+def figure(value: Any, fmt: str = ".3g", missing: str = "—") -> str:
+    """``value`` formatted for a progress message, ``missing`` where it does not exist yet (None, NaN,
+    inf): a user reads ``success —``, never ``success nan``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return missing
+    return format(v, fmt) if math.isfinite(v) else missing
 
 
 class Channel:

@@ -163,7 +163,9 @@ class GetupTask(PolicyTask):
             prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
             extra["getup_history"] = np.vstack([prev, [row]])
             if progress is not None:
-                shown = f"{row[1]:.2f}" if math.isfinite(row[1]) else "— (no episode from the ground ended yet)"
+                from toolkit.execution.progress import figure
+
+                shown = figure(row[1], ".2f", "— (no episode from the ground ended yet)")
                 progress(min(samples / max(total, 1), 1.0), f"success {shown}")
             return out
 

@@ -48,7 +48,10 @@ def curriculum_hooks(spec: Any, cur: Any, total_samples: int, progress: Optional
             prev = np.asarray(extra.get("novelty_history", np.zeros((0, 2))), dtype=np.float64).reshape(-1, 2)
             extra["novelty_history"] = np.vstack([prev, [[float(samples), float(np.mean(nov))]]])
         if progress is not None:
-            progress(min(samples / max(total_samples, 1), 1.0), f"{z_attr} {out.get(z_attr)}")
+            from toolkit.execution.progress import figure
+
+            progress(min(samples / max(total_samples, 1), 1.0), f"{z_attr} {figure(out.get(z_attr), '.3f')} m, "
+                                                                 f"success {figure(rate, '.2f')}")
         return out
 
     return Hooks(on_iteration=on_iteration, extra=extra, should_stop=cur.frozen, warm_start=warm_start,

@@ -40,7 +40,9 @@ def goal_hooks(total_samples: int, progress: Optional[Any]) -> Hooks:
         prev = np.asarray(extra.get("goal_history", np.zeros((0, 4))), dtype=np.float64).reshape(-1, 4)
         extra["goal_history"] = np.vstack([prev, [row]])
         if progress is not None:
-            progress(min(samples / max(total_samples, 1), 1.0), f"r_goal {row[1]:.3f}")
+            from toolkit.execution.progress import figure
+
+            progress(min(samples / max(total_samples, 1), 1.0), f"r_goal {figure(row[1], '.3f')}")
 
     return Hooks(on_iteration=on_iteration, extra=extra)
 

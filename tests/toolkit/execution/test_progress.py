@@ -91,3 +91,8 @@ def test_a_piped_run_has_no_control_characters(tmp_path):
     assert out.returncode == 0, out.stderr
     assert "\x1b" not in out.stdout + out.stderr and "\r" not in out.stdout + out.stderr
     assert "jt: [1/1] eval 0" in out.stderr
+
+
+def test_a_figure_that_does_not_exist_yet_is_a_dash():
+    assert P.figure(float("nan")) == "—" and P.figure(None) == "—" and P.figure(float("inf"), missing="-") == "-"
+    assert P.figure(0.12345, ".2f") == "0.12"
