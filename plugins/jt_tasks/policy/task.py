@@ -43,11 +43,11 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
     if name in ("pvae", "cvae") and not prior:
         raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
                       f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
-    if prior and prior != "auto":  # it must exist before the run opens (auto: found or trained by the runner)
-        from toolkit.priors.io import find_prior
+    if prior and prior != "auto":  # read and checked before the run opens (auto: found or trained by the runner)
+        from toolkit.priors.io import load_prior
 
         store = str(group_of(action, "store") or "").strip() or group_of(cfg, "store")  # action.store first
-        find_prior(prior, None if store is None else str(store), name)
+        load_prior(prior, None if store is None else str(store), name)  # format, kind, shapes: one line each
     trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
 
 

@@ -61,11 +61,11 @@ def test_cvae_condition_is_the_target_curves_now(priors):
 
 
 def test_a_pvae_prior_given_to_cvae_is_one_line(priors):
+    """Found when the config is composed, before a run opens (issue 30, item 2)."""
     from toolkit import plugins
 
-    task = plugins.load("task", "getup")(getup_cfg("action=cvae", f"action.prior={priors['pvae']}"))
-    with pytest.raises(JtError, match="pvae prior, action=cvae needs a cvae one") as e:
-        task.make_env(None, seed=0)
+    with pytest.raises(JtError, match="pvae prior, action=cvae needs a cvae one") as e:  # at composition
+        plugins.load("task", "getup")(getup_cfg("action=cvae", f"action.prior={priors['pvae']}"))
     assert "\n" not in str(e.value)
 
 
@@ -116,3 +116,14 @@ def test_a_prior_named_by_run_id_is_looked_up_in_action_store(tmp_path):
     assert cfg.action.prior == rid
     with pytest.raises(JtError, match="action.prior"):
         compose(["task=getup", *FAST, "action=cvae", f"action.prior={rid}", f"store={mine}"])
+
+
+@pytest.mark.parametrize("content", [b"garbage", b""])
+def test_a_prior_file_that_is_not_one_is_refused_at_composition(content, tmp_path):
+    from toolkit.config import compose
+
+    bad = tmp_path / "prior.h5"
+    bad.write_bytes(content)
+    with pytest.raises(JtError, match=r"prior.h5: unreadable pose prior") as e:
+        compose(["task=getup", *FAST, "action=cvae", f"action.prior={bad}", f"store={tmp_path / 's'}"])
+    assert "\n" not in str(e.value) and not (tmp_path / "s").exists()
