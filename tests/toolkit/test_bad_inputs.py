@@ -83,3 +83,30 @@ def test_a_comparison_cannot_vary_its_store(tmp_path):
     with pytest.raises(JtError, match=r"bad --vary 'store=.*': a comparison and its runs live in one store"):
         compare(["task=zdt1", f"store={tmp_path / 's'}"], [f"store={tmp_path / 'a'},{tmp_path / 'b'}"], 1)
     assert not any((tmp_path / n).exists() for n in ("s", "a", "b"))
+
+
+def test_files_named_in_a_config_are_read_before_anything_runs(tmp_path):
+    """Issue 30, item 2: a garbage trained policy for task.evaluate, a motion file with bad JSON or
+    one frame: one line naming the file, no store."""
+    import json
+    import os
+
+    import pybullet_data
+
+    from toolkit.config import compose
+
+    junk = tmp_path / "junk.h5"
+    junk.write_text("junk")
+    walk = json.loads(open(os.path.join(pybullet_data.getDataPath(), "data/motions/humanoid3d_walk.txt")).read())
+    one = tmp_path / "one.txt"
+    one.write_text(json.dumps({**walk, "Frames": walk["Frames"][:1]}))
+    store = tmp_path / "store"
+    for overrides, message in [
+        (["task=getup", "action=raw", f"task.evaluate={junk}"], r"task.evaluate=.*junk.h5 is not a jt PPO checkpoint"),
+        (["task=spd_tracking", f"task.motion={junk}"], r"task.motion=.*junk.h5: bad JSON"),
+        (["task=spd_tracking", f"task.motion={one}"], r"task.motion=.*one.txt: 'Frames' must be a list of at least 2"),
+    ]:
+        with pytest.raises(JtError, match=message) as e:
+            compose([*overrides, f"store={store}"])
+        assert "\n" not in str(e.value)
+    assert not store.exists()

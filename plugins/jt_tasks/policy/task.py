@@ -59,10 +59,18 @@ def trained_policy(cfg: Any, task: str) -> Optional[Path]:
         return None
     from toolkit.store.resolve import resolve
 
+    from toolkit.errors import JtError
+    from toolkit.rl.checkpoint import load_attrs
+
     store = group_of(cfg, "store")
-    return resolve(ref, artifact=tr.CHECKPOINT, store=None if store is None else str(store),
-                   what="task.evaluate", label="trained policy",
-                   hint=f"train one with: jt run task={task}").path
+    path = resolve(ref, artifact=tr.CHECKPOINT, store=None if store is None else str(store),
+                   what="task.evaluate", label="trained policy", hint=f"train one with: jt run task={task}").path
+    try:  # read now, before a run opens: a file that is no PPO checkpoint is one line
+        load_attrs(path)
+    except (OSError, ValueError, KeyError) as e:
+        raise JtError(f"task.evaluate={ref}: {path} is not a jt PPO checkpoint "
+                      f"({str(e).splitlines()[0][:160]}); train one with: jt run task={task}") from None
+    return path
 
 
 @dataclasses.dataclass

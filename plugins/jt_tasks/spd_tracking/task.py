@@ -125,6 +125,12 @@ class SPDTrackingTask(Task):
             raise JtError(f"task.motion={motion}: {e}") from None
         if not os.path.isfile(path):
             raise JtError(f"task.motion={motion}: no such file")
+        from toolkit.motion.clips import ClipError, load_clip
+
+        try:  # read now, before a run opens: a file that is no clip (bad JSON, one frame) is one line
+            load_clip(path)
+        except ClipError as e:
+            raise JtError(f"task.motion={motion}: {e}") from None
 
     def __init__(self, cfg: Any) -> None:
         from toolkit.config import config_of
