@@ -141,6 +141,26 @@ class RayExecutor(Executor):
         """Send evaluation folders between driver and worker: ``auto`` (when the worker does not
         see the driver's folder), ``always`` (no shared filesystem) or ``never`` (shared)."""
 
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """Before a run opens: Ray is installed and a cluster answers at ``executor.address``
+        (``HOST:PORT`` is tried; ``auto`` needs ``$RAY_ADDRESS`` or a cluster started on this
+        machine), so a missing cluster is one line, not a FAILED run."""
+        import importlib.util
+        import os
+
+        from toolkit.config import group_of
+
+        if importlib.util.find_spec("ray") is None:
+            raise JtError("executor=ray needs Ray: pip install -e '.[ray]'")
+        address = str(group_of(group_of(cfg, "executor") or {}, "address") or "auto")
+        if address == "auto" and not os.environ.get("RAY_ADDRESS") and \
+                not os.path.exists(os.path.join(os.environ.get("RAY_TMPDIR", "/tmp"), "ray", "ray_current_cluster")):
+            raise JtError("executor=ray: no Ray cluster on this machine (executor.address=auto); start one with "
+                          "ray start --head, or give executor.address=HOST:PORT; on one machine executor=local "
+                          "needs none")
+        _check_reachable(address)
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         try:

@@ -33,6 +33,7 @@ CASES = [
     (["task=standing_jump", "action=pvae"], r"task=standing_jump does not read an action group; drop action=pvae"),
     # issue 30: values that ran (or failed after the run opened)
     (["~task"], r"a run needs a task: task=<name>; choose one of: .*getup"),
+    (["task=zdt1", "executor=ray", "executor.address=127.0.0.1:1"], r"executor.address=127.0.0.1:1: no Ray cluster answers"),
     (["task=spd_tracking", "task.rates_hz=[]"], r"task.rates_hz=\[\]: one or more rates > 0 Hz"),
     (["task=spd_tracking", "task.duration=-1"], r"task.duration=-1.0: must be >= 0 s"),
     (["task=getup", "action=raw", "task.terrain=null", "task.eval_regions=[flat,hard]"],
