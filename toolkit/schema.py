@@ -266,10 +266,41 @@ def run_checks(cfg: Any) -> None:
             article = "an" if g[0] in "aeiou" else "a"
             drop = f"{g}={what}" if what else f"the {g}= choice"
             raise JtError(f"task={task['name']} does not read {article} {g} group; drop {drop} (it would be ignored)")
+    if task is not None and "name" in task:
+        check_declared_needs(cfg, plugins.load("task", str(task["name"])))
     for group in plugins.KINDS:
         node = cfg.get(group)
         if node is not None and "name" in node and group != "reward":
             plugins.load(group, str(node["name"])).check_run(cfg)
+
+
+def check_declared_needs(cfg: Any, task_cls: type) -> None:
+    """What the chosen reward terms, action space and curriculum need against what the task says
+    it provides (``Task.record_keys``, ``action_inputs``, ``curriculum_attrs``; an undeclared
+    side is not checked): one ``JtError`` line naming both sides, before a run opens."""
+    name = str(cfg.task["name"])
+    provided = getattr(task_cls, "record_keys", None)
+    reward = cfg.get("reward")
+    if provided is not None and reward is not None and reward.get("terms"):
+        for term, params in dict(reward["terms"]).items():
+            missing = sorted(plugins.load("reward", str(term)).needs(params or {}) - set(provided))
+            if missing:
+                raise JtError(f"reward term {term} reads record key(s) {', '.join(missing)}, which task={name}'s "
+                              f"records do not have (they have: {', '.join(sorted(provided))})")
+    inputs = getattr(task_cls, "action_inputs", None)
+    action = cfg.get("action")
+    if inputs is not None and action is not None and "name" in action:
+        needs = set(getattr(plugins.load("action", str(action["name"])), "needs", frozenset()))
+        if needs - set(inputs):
+            raise JtError(f"action={action['name']} needs {', '.join(sorted(needs - set(inputs)))} from the task, which "
+                          f"task={name} does not give (it gives: {', '.join(sorted(inputs)) or 'nothing'})")
+    attrs = getattr(task_cls, "curriculum_attrs", None)
+    cur = cfg.get("curriculum")
+    if attrs is not None and cur is not None and "name" in cur:
+        driven = plugins.load("curriculum", str(cur["name"])).drives(cur) - set(attrs)
+        if driven:
+            raise JtError(f"curriculum={cur['name']} drives {', '.join(sorted(driven))}, which task={name}'s env does "
+                          f"not have (a curriculum for it drives: {', '.join(sorted(attrs)) or 'nothing'})")
 
 
 def validate(cfg: Any, overrides: Sequence[tuple[str, Any]] = (), run_checks_too: bool = True) -> Any:

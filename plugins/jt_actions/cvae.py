@@ -15,7 +15,7 @@ Naturalness (``003`` eq 3): ``1 - clip((||Δq||_1 / c)^2, 0, 1)`` with the filte
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -28,6 +28,7 @@ class CVAEActionSpace(PVAEActionSpace):
     """Action = filtered [C-VAE latent, offsets]; target = decode(latent, c) + offset (003 §3.4)."""
 
     kind = "cvae"
+    needs: ClassVar[frozenset[str]] = frozenset({"condition"})  #: c = the task's curve targets (003 §3.4)
 
     @dataclasses.dataclass
     class Config(FilterCheck):

@@ -25,7 +25,7 @@ import dataclasses
 import math
 import os
 from numbers import Real
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -73,6 +73,8 @@ def unwrap_expmaps(v: np.ndarray) -> np.ndarray:
 
 class FFCFBCActionSpace(DofActionSpace):
     """Target = reference pose at the phase (feed-forward) + the policy's correction (002 §4.2)."""
+
+    needs: ClassVar[frozenset[str]] = frozenset({"phase"})  #: the reference clip's phase each control step
 
     @dataclasses.dataclass
     class Config(FilterCheck):

@@ -33,6 +33,10 @@ class ActionSpace(GroupPlugin, abc.ABC):
     """
 
     what: ClassVar[str] = "action={name}"
+    #: what it needs from the task's environment besides the action: ``"condition"``
+    #: (``set_condition``), ``"phase"`` (``set_phase``); checked at composition against
+    #: ``Task.action_inputs`` where a task declares them
+    needs: ClassVar[frozenset[str]] = frozenset()
 
     skeleton: Any = None
     filtered: Any = None

@@ -29,6 +29,14 @@ stop early). ``jt_curricula.base.IterationCurriculum``
 
     extra_key: ClassVar[str] = "curriculum"
 
+    @classmethod
+    def drives(cls, params: Any) -> set[str]:
+        """The environment attributes this curriculum sets (``env_attrs``) with ``params``: by
+        default the values of its fields ending in ``_attr``. Composition checks them against the
+        task's declared ``Task.curriculum_attrs``; a curriculum that sets others overrides this."""
+        items = params.items() if hasattr(params, "items") else vars(params).items()
+        return {str(v) for k, v in items if str(k).endswith("_attr") and v}
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
 

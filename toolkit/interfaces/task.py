@@ -84,6 +84,15 @@ class Task(Plugin, abc.ABC):
         ignores_groups: the optional groups (``action``, ``reward``, ``curriculum``) this task
             never reads; choosing one of them for it is refused at composition, in one line,
             instead of being silently ignored. Empty by default (a task may read any group).
+        record_keys: the keys of the records its reward terms are given (None: not declared, not
+            checked). With it, composition refuses a ``reward`` term that reads a key the records
+            do not have (``RewardTerm.needs``), in one line, before a run opens.
+        action_inputs: what its environment gives an action space besides the action
+            (``"condition"``: ``set_condition``, ``"phase"``: ``set_phase``; None: not declared).
+            With it, composition refuses an action space whose ``ActionSpace.needs`` it lacks.
+        curriculum_attrs: the environment attributes a curriculum may drive (None: not
+            declared). With it, composition refuses a curriculum that drives others
+            (``Curriculum.drives``): it would set attributes nothing reads.
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
@@ -93,6 +102,9 @@ class Task(Plugin, abc.ABC):
     timing_metrics: ClassVar[tuple[str, ...]] = ()
     curve_prefix: ClassVar[str] = "train/"
     ignores_groups: ClassVar[tuple[str, ...]] = ()
+    record_keys: ClassVar[Optional[frozenset[str]]] = None
+    action_inputs: ClassVar[Optional[frozenset[str]]] = None
+    curriculum_attrs: ClassVar[Optional[frozenset[str]]] = None
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg

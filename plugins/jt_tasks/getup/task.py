@@ -41,6 +41,12 @@ class GetupTask(PolicyTask):
                                               "success_hard", "success_rate", "r_task_mean", "task_return_rate")
     Config: ClassVar[type] = GetupConfig
     env_path: ClassVar[str] = "jt_tasks.getup.env:GetupEnv"
+    #: what GetupEnv.record_now gives the reward terms, what it gives an action space, what a curriculum may drive
+    record_keys: ClassVar[frozenset[str]] = frozenset({
+        "h", "theta_x", "theta_z", "target_h", "target_theta_x", "target_theta_z", "target_h_end",
+        "link_ang_vel", "joint_rotations", "neutral_rotations", "naturalness"})
+    action_inputs: ClassVar[frozenset[str]] = frozenset({"condition"})
+    curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"terrain_level"})
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

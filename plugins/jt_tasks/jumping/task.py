@@ -53,6 +53,7 @@ class JumpTask(PolicyTask):
     feature_names: ClassVar[tuple[str, ...]] = ("alpha", "omega_x", "omega_z", "v_z")
     Config: ClassVar[type] = JumpConfig
     env_path: ClassVar[str] = "jt_tasks.jumping.env:JumpEnv"
+    action_inputs: ClassVar[frozenset[str]] = frozenset()  #: neither a phase nor a C-VAE condition
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

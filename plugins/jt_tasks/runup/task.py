@@ -80,6 +80,7 @@ class RunupTask(PolicyTask):
     key_metrics: ClassVar[tuple[str, ...]] = ("goal_reward", "imitation_reward", "mean_return")
     Config: ClassVar[type] = RunupConfig
     env_path: ClassVar[str] = "jt_tasks.runup.env:RunupEnv"
+    action_inputs: ClassVar[frozenset[str]] = frozenset()  #: neither a phase nor a C-VAE condition
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

@@ -36,6 +36,16 @@ class SpacetimeTask(PolicyTask):
     key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "samples", "train_mean_length")
     Config: ClassVar[type] = SpacetimeConfig
     env_path: ClassVar[str] = "jt_tasks.spacetime.env:SpacetimeEnv"
+    #: its rewards are task.style's terms and the bounds; no curriculum drives it
+    ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum")
+    action_inputs: ClassVar[frozenset[str]] = frozenset({"phase"})  #: the reference clip's phase
+
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """The humanoid: its bounds, channels and reference clips are the DeepMimic humanoid's."""
+        from jt_tasks.policy.task import require_humanoid_and_prior
+
+        require_humanoid_and_prior(cfg, "spacetime", "its bounds and reference clips are the DeepMimic humanoid's")
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
