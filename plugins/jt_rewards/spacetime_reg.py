@@ -104,6 +104,14 @@ class SpacetimeReg(RecordTerm):
         (unless the config names one).
     """
 
+    @classmethod
+    def needs(cls, params: Any) -> set[str]:
+        """The link velocities and accelerations, masses, joint accelerations, and the record's
+        ``clip`` unless the term names its own."""
+        clip = params.get("clip") if hasattr(params, "get") else getattr(params, "clip", None)
+        return {"link_vel", "link_acc", "masses", "joint_acc"} | (set() if clip is not None else {"clip"})
+
+
     @dataclasses.dataclass
     class Config:
         clip: Optional[str] = None

@@ -40,6 +40,11 @@ class Energy(RecordTerm):
         ``rotational_energy`` J, optional).
     """
 
+    @classmethod
+    def needs(cls, params: Any) -> set[str]:
+        """``link_vel`` and ``masses`` (what an env records; ``kinetic_energy`` may stand for them)."""
+        return {"link_vel", "masses"}
+
     @dataclasses.dataclass
     class Config:
         mode: str = "decrease"
@@ -81,6 +86,11 @@ class Volume(RecordTerm):
     Record keys:
         ``joint_pos`` ``(n, 3)``: the joint positions (m).
     """
+
+    @classmethod
+    def needs(cls, params: Any) -> set[str]:
+        """``joint_pos``."""
+        return {"joint_pos"}
 
     @dataclasses.dataclass
     class Config:

@@ -65,6 +65,14 @@ class RewardTermContract:
         assert a == b
         assert repr(rec) == repr(self.record)  # the record is not modified
 
+    def test_declares_the_record_keys_it_reads(self):
+        """``RewardTerm.needs`` (checked against a task's ``record_keys`` at composition) names the
+        keys this term reads: a record of only those keys works."""
+        needs = self.cls.needs(dataclasses.asdict(self.cls().params))
+        assert isinstance(needs, set) and all(isinstance(k, str) for k in needs)
+        assert needs <= set(self.record), f"needs() names keys the contract's record lacks: {needs - set(self.record)}"
+        self.cls()({k: v for k, v in self.record.items() if k in needs})  # enough: nothing undeclared is read
+
     def test_missing_record_key_names_it(self):
         for key in self.required:
             rec = {k: v for k, v in self.record.items() if k != key}

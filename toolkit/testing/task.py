@@ -110,6 +110,18 @@ class TaskContract:
                 assert config_of(cls.Config, node, group) == config_of(cls.Config, printed[group], group), group
         assert OmegaConf.to_container(cfg, resolve=True) == OmegaConf.to_container(printed, resolve=True)
 
+    def test_its_declarations_are_well_formed(self):
+        """``record_keys``, ``action_inputs`` and ``curriculum_attrs`` are None (not declared) or sets
+        of names; the smoke preset's own choices satisfy them (composition checks them)."""
+        from toolkit import plugins
+        from toolkit.config import compose
+
+        cls = plugins.load("task", self.task)
+        for attr in ("record_keys", "action_inputs", "curriculum_attrs"):
+            v = getattr(cls, attr, None)
+            assert v is None or (isinstance(v, frozenset) and all(isinstance(k, str) for k in v)), attr
+        compose([f"task={self.task}", *self.overrides, "experiment=smoke"])  # its own choices pass
+
     def test_smoke_run_finishes_with_its_artifacts(self, smoke):
         runs = _evaluation_runs(smoke)
         assert runs[0].info.status == "FINISHED"

@@ -12,11 +12,12 @@ from toolkit.testing.reward import RewardTermContract
 from toolkit.errors import JtError
 
 CUBE = np.array([[x, y, z] for x in (0, 0.5) for y in (0, 0.6) for z in (0, 0.4)], dtype=float)  # 0.12 m³
-RECORD = {"kinetic_energy": 60.0, "joint_pos": CUBE}
+RECORD = {"kinetic_energy": 60.0, "joint_pos": CUBE, "link_vel": np.full((15, 3), 0.8), "masses": np.full(15, 3.0)}
 
 
 class TestEnergy(RewardTermContract):
-    cls, entry, record, required = Energy, "energy", RECORD, ("kinetic_energy",)
+    # kinetic_energy, or link_vel and masses: no single key the term cannot do without
+    cls, entry, record, required = Energy, "energy", RECORD, ()
     cases = [({}, {"kinetic_energy": 60.0}, 0.5), ({}, {"kinetic_energy": 10.0}, 1.0),
              ({}, {"kinetic_energy": 120.0}, 0.0), ({"mode": "increase"}, {"kinetic_energy": 40.0}, 0.25),
              ({"e_min": 0.0, "e_max": 10.0}, {"kinetic_energy": 2.5}, 0.75)]
@@ -48,3 +49,8 @@ def test_hull_volume_of_a_box_and_bad_modes():
             cls({"mode": "more"})
     with pytest.raises(JtError):
         Energy({"e_min": 100.0, "e_max": 20.0})
+
+
+def test_energy_without_either_source_names_both():
+    with pytest.raises(KeyError, match="kinetic_energy.*link_vel"):
+        Energy()({"joint_pos": CUBE})
