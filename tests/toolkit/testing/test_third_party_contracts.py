@@ -101,6 +101,10 @@ class TPUpright(RewardTerm):
         super().__init__(cfg)
         self.params = config_of(self.Config, cfg, "reward=tp_upright")
 
+    @classmethod
+    def needs(cls, params):
+        return {"tilt"}  # the record key it reads (checked against a task's record_keys)
+
     def __call__(self, record):
         import math
 
