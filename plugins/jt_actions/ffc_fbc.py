@@ -95,6 +95,12 @@ class FFCFBCActionSpace(DofActionSpace):
             super().check()
             if self.output_scale not in ("range", "none"):
                 raise JtError(f"action.output_scale={self.output_scale!r}: range (the authors' joint ranges) or none")
+            from toolkit.motion.clips import ClipError, load_clip
+
+            try:  # read at composition: a missing or broken clip is one line before a run opens
+                load_clip(resolve_clip(self.clip))
+            except ClipError as e:
+                raise JtError(f"action.clip={self.clip}: {e}") from None
 
     def __init__(self, cfg: Any = None, character: Any = None) -> None:
         super().__init__(cfg, character)

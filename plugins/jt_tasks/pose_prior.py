@@ -69,6 +69,19 @@ class PosePriorTask(Task):
         samples: int = 8
         """Decoded random latents in prior_samples.png."""
 
+        def check(self) -> None:
+            """A ``task.dataset`` is read at composition (one line naming the file), before a run opens."""
+            if not str(self.dataset).strip():
+                return
+            from toolkit.errors import JtError
+            from toolkit.motion.dataset import load_dataset
+
+            try:
+                load_dataset(self.dataset)
+            except (OSError, ValueError, KeyError) as e:
+                raise JtError(f"task.dataset={self.dataset}: not a jt pose dataset ({str(e).splitlines()[0][:160]}); "
+                              "make one with: python -m toolkit.motion.dataset, or leave it empty") from None
+
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
         group = cfg.get("task") if cfg is not None and hasattr(cfg, "get") else None

@@ -34,6 +34,8 @@ CASES = [
     # issue 30: values that ran (or failed after the run opened)
     (["~task"], r"a run needs a task: task=<name>; choose one of: .*getup"),
     (["task=zdt1", "executor=ray", "executor.address=127.0.0.1:1"], r"executor.address=127.0.0.1:1: no Ray cluster answers"),
+    (["task=spacetime", "action.clip=/no/such.txt"], r"action=ffc_fbc: no clip '/no/such.txt'; give a path or one of"),
+    (["task=pose_prior", "action=pvae", "task.dataset=/no/such.h5"], r"task.dataset=/no/such.h5: not a jt pose dataset"),
     (["task=spd_tracking", "task.rates_hz=[]"], r"task.rates_hz=\[\]: one or more rates > 0 Hz"),
     (["task=spd_tracking", "task.duration=-1"], r"task.duration=-1.0: must be >= 0 s"),
     (["task=getup", "action=raw", "task.terrain=null", "task.eval_regions=[flat,hard]"],
