@@ -39,7 +39,6 @@ class RewardTerm(GroupPlugin, abc.ABC):
             name = str(name)
             if name in cls.optional_keys or not (name in ("key", "keys") or name.endswith(("_key", "_keys"))):
                 continue
-            values = value if isinstance(value, (list, tuple)) or (hasattr(value, "__iter__") and
-                                                                   not isinstance(value, str)) else [value]
+            values = [value] if isinstance(value, str) or not hasattr(value, "__iter__") else list(value)
             out.update(str(v) for v in values if v is not None and str(v))
         return out
