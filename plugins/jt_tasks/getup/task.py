@@ -13,7 +13,6 @@ not terminated early, from a fallen start (clip or rag-doll), whose neck height 
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 from typing import Any, ClassVar, Optional
@@ -25,6 +24,7 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.getup.config import GetupConfig
+from jt_tasks.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
 from jt_tasks.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
@@ -152,33 +152,19 @@ class GetupTask(PolicyTask):
         node = group_of(self.cfg, "curriculum")
         cur = plugins.load("curriculum", str(node.name))(node) if node is not None and "name" in node else None
         extra: dict[str, Any] = cur.bind({}) if cur is not None else {}
-        progress = ctx.progress
 
-        def mean(eps: list, key: str) -> float:
-            return float(np.mean([e.get(key, 0.0) for e in eps])) if eps else math.nan
-
-        def on_iteration(it: int, samples: int, stats: Any) -> dict[str, Any]:
-            out = cur.on_iteration(it, samples, stats) if cur is not None else {}
-            eps = getattr(stats, "episodes", []) or []
+        def row(eps: list, stats: Any) -> list[float]:  # ground starts only, then by start kind
             ground = [e for e in eps if e.get("start_kind", 0.0) != 2.0 and not e.get("start_time", 0.0)]
-            by_kind = {k: [e for e in ground if e.get("start_kind", 0.0) == float(i)] for i, k in ((0, "clip"),
-                                                                                                   (1, "fallen"))}
-            row = [float(samples)] + [mean(ground, k) for k in HISTORY[:5]] + \
-                [mean(by_kind["clip"], "success"), mean(by_kind["fallen"], "success")]
-            prev = np.asarray(extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
-            prev = prev.reshape(len(prev), -1) if prev.size else np.zeros((0, 1 + len(HISTORY)))
-            extra["getup_history"] = np.vstack([prev, [row]])
-            if progress is not None:
-                from toolkit.execution.progress import figure
+            kinds = [[e for e in ground if e.get("start_kind", 0.0) == k] for k in (0.0, 1.0)]
+            return [mean_of(ground, k) for k in HISTORY[:5]] + [mean_of(eps_k, "success") for eps_k in kinds]
 
-                shown = figure(row[1], ".2f", "— (no episode from the ground ended yet)")
-                progress(min(samples / max(total, 1), 1.0), f"success {shown}")
-            return out
-
+        hist = IterationHistory(extra, "getup_history", HISTORY, total, ctx.progress, row,
+                                ("success", ".2f", "— (no episode from the ground ended yet)"),
+                                cur.on_iteration if cur is not None else None)
         p = self.params
         hook = ClipStartTraining(functools.partial(self.env_class, spec, seed=ctx.seed), p.eval_clip_during,
-                                 p.eval_start_noise, p.eval_every, extra, on_iteration, progress, total)
-        return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook})
+                                 p.eval_start_noise, p.eval_every, extra, hist.on_iteration, ctx.progress, total)
+        return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook, "history": hist})
 
     def final_options(self, env: Any) -> Optional[dict]:
         return {"kind": "clip", "curve": self.params.eval_curve}
@@ -203,8 +189,7 @@ class GetupTask(PolicyTask):
         info = ro["info"]
         ro["log"] = list(env.log)
         data = {"features": ro["features"], "targets": ro["targets"],
-                "curve_control": np.asarray(env.curve.control), "info": {k: float(v) for k, v in info.items()
-                                                                        if isinstance(v, (int, float))}}
+                "curve_control": np.asarray(env.curve.control), "info": numbers(info)}
         if env.log:
             data["terms"] = {k: np.array([row[k] for row in env.log]) for k in env.log[0]}
         attrs = {"curve": env.curve.name, "duration": float(env.curve.duration), "start_kind": env.start_kind,
@@ -212,7 +197,7 @@ class GetupTask(PolicyTask):
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Hooks, workdir: Path) -> Evaluation:
-        from jt_tasks.policy.train import last_finite, return_curve, rollout
+        from jt_tasks.policy.train import return_curve, rollout
         from toolkit.rl.checkpoint import load_policy
 
         from jt_tasks.getup import evaluate as E
@@ -233,11 +218,7 @@ class GetupTask(PolicyTask):
             "got_up_rate": float(np.mean([i.get("got_up", 0.0) for i in infos])),
             "r_task_mean": float(info.get("r_task_mean", 0.0)),
             "task_return_rate": float(np.mean([i.get("task_return_rate", 0.0) for i in infos])),
-            "episode_time": float(info.get("episode_time", 0.0)), "mean_return": float(ro["return"]),
-            "train_mean_return": last_finite(res.history.get("mean_return", [])),
-            "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
-        }
+            "episode_time": float(info.get("episode_time", 0.0)), **base_metrics(ro, trained)}
         if p.eval_clip_starts > 0:  # issue 29's stage 1: perturbed clip starts, seeds never used in training
             from jt_tasks.getup.stage1 import clip_start_success
 
@@ -264,12 +245,8 @@ class GetupTask(PolicyTask):
             level = cur.env_attrs().get("terrain_level")  # what the env reads (Curriculum.env_attrs)
             if level is not None:
                 metrics["terrain_level"] = float(level)
-        metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
-        hist = np.asarray(res.extra.get("getup_history", np.zeros((0, 1 + len(HISTORY)))), dtype=np.float64)
-        hist = hist.reshape(len(hist), -1) if hist.size else np.zeros((0, 1 + len(HISTORY)))
-        history = {"mean_return": return_curve(trained)}
-        for col, key in enumerate(HISTORY[:hist.shape[1] - 1], start=1):
-            history[f"train_{key}"] = [(int(r[0]), float(r[col])) for r in hist if math.isfinite(r[col])]
+        metrics = finite(metrics)
+        history = {"mean_return": return_curve(trained), **hooks.state["history"].curves(res.extra, prefix="train_")}
         rows = hooks.state["training"].history() if "training" in hooks.state else np.zeros((0, 3))
         if len(rows):  # the deterministic get-ups from perturbed clip starts during training
             history["eval_success_clip"] = [(int(r[0]), float(r[1])) for r in rows]

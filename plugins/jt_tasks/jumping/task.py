@@ -228,7 +228,8 @@ class JumpTask(PolicyTask):
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
         from jt_tasks.jumping.train import jump_curves
-        from jt_tasks.policy.train import last_finite, return_curve
+        from jt_tasks.policy.history import base_metrics, finite
+        from jt_tasks.policy.train import return_curve
 
         res, init = trained.result, self.stage2_init()
         trained_z = float(hooks.state["cur"].env_attrs().get(hooks.state["z_attr"], math.nan))  # the curriculum's z
@@ -236,14 +237,8 @@ class JumpTask(PolicyTask):
         angle = float(ro["feature_angle"])
         metrics = {
             "strategy_angle": angle, "bar_height_reached": float(ro.get("final_z", trained_z)),
-            "bar_height_trained": trained_z,
-            "mean_return": float(ro["return"]),
-            "train_mean_return": last_finite(res.history.get("mean_return", [])),
-            "success_rate": succ[-1] if succ else 0.0,
-            "final_success": float(ro["info"].get("success", 0.0)),
-            "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
-        }
+            "bar_height_trained": trained_z, **base_metrics(ro, trained),
+            "success_rate": succ[-1] if succ else 0.0, "final_success": float(ro["info"].get("success", 0.0))}
         metrics.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
         metrics.update({f"feature_q{i}": float(v) for i, v in enumerate(ro["feature_quat"])})
         if init is not None:
@@ -254,7 +249,7 @@ class JumpTask(PolicyTask):
         history = {"mean_return": return_curve(trained), **jump_curves(hooks, res)}
         self._write_peak(ro, workdir)
         if not math.isfinite(angle):
-            return Evaluation(metrics={k: v for k, v in metrics.items() if math.isfinite(v)}, failed=True,
+            return Evaluation(metrics=finite(metrics), failed=True,
                               reason="the deterministic jump never crossed the bar plane", history=history)
         return Evaluation(metrics=metrics, features=[angle], history=history)
 

@@ -154,12 +154,9 @@ class PolicyTask(Task):
 
     def measure(self, spec: Any, ro: dict, trained: tr.Trained, hooks: Hooks, workdir: Path) -> Evaluation:
         """The evaluation's metrics from the deterministic rollout and the training."""
-        res = trained.result
-        metrics = {"mean_return": float(ro["return"]),
-                   "train_mean_return": tr.last_finite(res.history.get("mean_return", [])),
-                   "samples": float(res.samples), "iterations": float(res.iterations),
-                   "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s)}
-        return Evaluation(metrics=metrics, history={"mean_return": tr.return_curve(trained)})
+        from jt_tasks.policy.history import base_metrics
+
+        return Evaluation(metrics=base_metrics(ro, trained), history={"mean_return": tr.return_curve(trained)})
 
     # ------------------------------------------------------------------ shared wiring
     @property

@@ -14,7 +14,6 @@ for a jump task to start from. docs/runup.md.
 from __future__ import annotations
 
 import dataclasses
-import math
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
@@ -24,7 +23,12 @@ from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.task import PolicyConfig, PolicyTask, require_humanoid_and_prior
+from jt_tasks.policy.history import IterationHistory, base_metrics, finite, numbers
+from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask, require_humanoid_and_prior
+
+#: per-iteration means of the finished episodes (``extra["goal_history"]``), and their curves' names
+HISTORY = ("r_goal", "r_imitation_mean", "took_off")
+CURVES = {"r_goal": "goal_reward", "r_imitation_mean": "imitation_reward", "took_off": "takeoff_rate"}
 
 
 def jump_task_box(kind: str) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
@@ -125,15 +129,20 @@ class RunupTask(PolicyTask):
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Any:
+        """The per-iteration means of finished episodes' ``r_goal``, imitation reward and take-off
+        rate (``extra["goal_history"]``)."""
         from jt_tasks.policy.train import agent_config
-        from jt_tasks.runup.train import goal_hooks
 
-        return goal_hooks(agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples, ctx.progress)
+        extra: dict[str, Any] = {}
+        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
+        hist = IterationHistory(extra, "goal_history", HISTORY, total, ctx.progress, shown=("r_goal", ".3f"))
+        return Hooks(on_iteration=hist.on_iteration, extra=extra, state={"history": hist})
 
     def final_options(self, env: Any) -> Optional[dict]:
-        from jt_tasks.runup.train import eval_start
-
-        return {"time": eval_start(env, self.params.eval_lead)}
+        """The take-off foot's mid-support, or ``eval_lead`` s before it: the run-up lasts
+        ``n_strides`` whole cycles by default."""
+        lead = self.params.eval_lead
+        return {"time": float(env.ref.t_mid - (0.0 if lead is None else float(lead)))}
 
     def record(self, env: Any) -> dict[str, Any]:
         out = super().record(env)
@@ -146,36 +155,27 @@ class RunupTask(PolicyTask):
         ro["targets"] = dict(env.targets)
         ro["phase_time"] = float(env.ref.phase(env.clip_time) * env.ref.period)
         data = {"ref_root": ro["ref_root"], "r_imitation": np.array([t["imitation"] for t in env.terms_log]),
-                "info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))}}
+                "info": numbers(info)}
         attrs = {"kind": spec.kind, "targets": str(ro["targets"]), "return": float(ro["return"]),
                  "reason": str(info.get("reason", ""))}
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
-        from jt_tasks.policy.train import last_finite, return_curve
-        from jt_tasks.runup.train import goal_curves
+        from jt_tasks.policy.train import return_curve
         from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
 
-        res, info = trained.result, ro["info"]
+        info = ro["info"]
         if info.get("took_off"):
             achieved = {k[len("takeoff_"):]: float(v) for k, v in info.items() if k.startswith("takeoff_")}
             write_takeoff_state(workdir / NAME, ro["q"], ro["qd"], achieved, ro["targets"], spec.foot, spec.kind,
                                 ro["phase_time"], float(info["r_goal"]))
-        metrics = {
-            "goal_reward": float(info.get("r_goal", 0.0)),
-            "imitation_reward": float(info.get("r_imitation_mean", 0.0)),
-            "mean_return": float(ro["return"]),
-            "train_mean_return": last_finite(res.history.get("mean_return", [])),
-            "took_off": float(info.get("took_off", 0.0)),
-            "episode_time": float(info.get("episode_time", 0.0)),
-            "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
-        }
-        for k in ("pose", "vel", "ee", "com"):
-            metrics[f"imitation_{k}"] = float(info.get(f"r_{k}_mean", 0.0))
-        metrics.update({k: float(v) for k, v in info.items() if k.startswith(("takeoff_", "target_"))})
-        metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
-        history = {"mean_return": return_curve(trained), **goal_curves(res)}
+        base = base_metrics(ro, trained)  # the summary line shows the first few: the task's own first
+        metrics = {"goal_reward": float(info.get("r_goal", 0.0)), "imitation_reward": float(info.get("r_imitation_mean", 0.0)),
+                   "mean_return": base.pop("mean_return"), "train_mean_return": base.pop("train_mean_return"),
+                   "took_off": float(info.get("took_off", 0.0)), "episode_time": float(info.get("episode_time", 0.0)), **base}
+        metrics.update({f"imitation_{k}": float(info.get(f"r_{k}_mean", 0.0)) for k in ("pose", "vel", "ee", "com")})
+        metrics = finite({**metrics, **{k: v for k, v in info.items() if k.startswith(("takeoff_", "target_"))}})
+        history = {"mean_return": return_curve(trained), **hooks.state["history"].curves(trained.result.extra, CURVES)}
         if not info.get("took_off"):
             return Evaluation(metrics=metrics, failed=True, history=history,
                               reason=f"the deterministic run-up ended before the take-off: {info.get('reason', '')}")

@@ -25,6 +25,7 @@ import numpy as np
 from toolkit.config import group_of
 from toolkit.interfaces.task import Evaluation
 
+from jt_tasks.policy.history import base_metrics, finite, numbers
 from jt_tasks.policy.task import Hooks, PolicyTask
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig
@@ -119,8 +120,7 @@ class SpacetimeTask(PolicyTask):
             h, w = np.asarray(ro["frames"][0]).shape[:2]
             ro["reference_frames"] = reference_frames(env, ro["time"], w, h)
             ro["fps"] = float(env.control_hz)
-        data = {"info": {k: float(v) for k, v in info.items() if isinstance(v, (int, float))},
-                "phase": ro["com_height"]["phase"]}
+        data = {"info": numbers(info), "phase": ro["com_height"]["phase"]}
         attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
                  "reason": str(info.get("reason", "")), "widths": str(list(spec.widths)),
                  **{f"{who}_{k}": v for who, m in ro["style"].items() for k, v in m.items()}}
@@ -137,16 +137,11 @@ class SpacetimeTask(PolicyTask):
             "survival_s": survival,
             "survival_steps": float(steps),
             "survived": float(bool(info.get("time_out", 0.0))),
-            "mean_return": float(ro["return"]),
-            "train_mean_return": last_finite(res.history.get("mean_return", [])),
-            "train_mean_length": last_finite(lengths),
-            "samples": float(res.samples), "iterations": float(res.iterations),
-            "samples_per_s": trained.samples_per_s, "train_wall_s": float(trained.wall_s),
-        }
+            **base_metrics(ro, trained), "train_mean_length": last_finite(lengths)}
         for who, m in ro.get("style", {}).items():  # style measures vs the reference's (002 §3.3, §5.3)
             prefix = "style" if who == "policy" else "ref"
             metrics.update({f"{prefix}_energy": m["energy"], f"{prefix}_volume": m["volume"]})
-        metrics = {k: v for k, v in metrics.items() if math.isfinite(v)}
+        metrics = finite(metrics)
         history = {"mean_return": return_curve(trained),
                    "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
         if "com_height" in ro:

@@ -1,0 +1,121 @@
+"""What every policy task keeps per PPO iteration and reports: one mechanism, not one per task.
+
+``IterationHistory`` is the training curve a task adds to PPO's: one row per iteration,
+``(samples, value, ...)``, each value a mean over the iteration's finished episodes (their final
+``info``) or anything the task computes; the rows live in PPO's ``extra`` under the task's key, so
+they are checkpointed in ``ppo.h5`` and a resumed run continues the curve. It also draws the
+evaluation's progress line with the task's key figure. ``base_metrics``, ``numbers`` and
+``finite`` are the metric plumbing every task's ``measure`` shares.
+
+Usage, in a task's ``training`` hook::
+
+    hist = IterationHistory(extra, "goal_history", ("r_goal", "took_off"), total, ctx.progress,
+                            shown=("r_goal", ".3f"))
+    hooks = Hooks(on_iteration=hist.on_iteration, extra=extra)
+    ...
+    hist.curves(result.extra, {"r_goal": "goal_reward"})   # in measure: {name: [(samples, v)]}
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Mapping, Optional, Sequence
+
+import numpy as np
+
+
+def mean_of(episodes: Sequence[Mapping[str, Any]], key: str) -> float:
+    """Mean of ``key`` over episode infos (a missing key counts 0); nan without an episode."""
+    return float(np.mean([float(e.get(key, 0.0)) for e in episodes])) if episodes else math.nan
+
+
+def numbers(info: Mapping[str, Any]) -> dict[str, float]:
+    """The numeric entries of an episode's ``info`` as floats (for ``rollout.h5``'s ``info``)."""
+    return {k: float(v) for k, v in info.items() if isinstance(v, (int, float))}
+
+
+def finite(metrics: Mapping[str, float]) -> dict[str, float]:
+    """``metrics`` without its nan / inf values (the store logs finite numbers only)."""
+    return {k: float(v) for k, v in metrics.items() if math.isfinite(float(v))}
+
+
+def base_metrics(ro: Mapping[str, Any], trained: Any) -> dict[str, float]:
+    """The metrics every policy task reports: the deterministic rollout's return and PPO's counters.
+
+    Args:
+        ro: the rollout (``jt_tasks.policy.train.rollout``), its ``return``.
+        trained: ``jt_tasks.policy.train.Trained``.
+
+    Returns:
+        ``mean_return``, ``train_mean_return`` (the last finite training mean), ``samples``,
+        ``iterations``, ``samples_per_s``, ``train_wall_s``.
+    """
+    from jt_tasks.policy.train import last_finite
+
+    res = trained.result
+    return {"mean_return": float(ro["return"]),
+            "train_mean_return": last_finite(res.history.get("mean_return", [])),
+            "samples": float(res.samples), "iterations": float(res.iterations),
+            "samples_per_s": float(trained.samples_per_s), "train_wall_s": float(trained.wall_s)}
+
+
+class IterationHistory:
+    """Per-iteration rows ``(samples, *columns)`` in PPO's ``extra[key]``, and the progress line.
+
+    Args:
+        extra: PPO's ``extra`` dict (checkpointed; a resumed run's rows are already in it).
+        key: the entry of ``extra`` (e.g. ``"goal_history"``).
+        columns: the row's value names, after ``samples``.
+        total_samples: the budget, for the progress fraction.
+        progress: ``progress(fraction, message)`` or None.
+        row: ``row(episodes, stats) -> values`` (one per column); default: each column's
+            ``mean_of`` over the iteration's finished episodes.
+        shown: ``(column, format)`` of the figure on the progress line, or ``(column, format,
+            missing)`` with the text shown while it is nan; None: no figure.
+        then: a further ``on_iteration(it, samples, stats)`` (e.g. a curriculum's), called first;
+            what it returns is returned (PPO applies it to the envs).
+    """
+
+    def __init__(self, extra: dict, key: str, columns: Sequence[str], total_samples: int,
+                 progress: Optional[Callable] = None,
+                 row: Optional[Callable[[list, Any], Sequence[float]]] = None,
+                 shown: Optional[tuple] = None, then: Optional[Callable] = None) -> None:
+        self.extra, self.key, self.columns = extra, key, tuple(columns)
+        self.total, self.progress, self.row, self.shown, self.then = int(total_samples), progress, row, shown, then
+
+    def rows(self, extra: Optional[Mapping] = None) -> np.ndarray:
+        """The rows ``(n_iterations, 1 + n_columns)`` in ``extra`` (default: the bound one)."""
+        width = 1 + len(self.columns)
+        saved = np.asarray((self.extra if extra is None else extra).get(self.key, np.zeros((0, width))),
+                           dtype=np.float64)
+        return saved.reshape(-1, width) if saved.size else np.zeros((0, width))
+
+    def on_iteration(self, it: int, samples: int, stats: Any) -> Any:
+        """PPO's ``on_iteration``: append this iteration's row, report progress."""
+        out = self.then(it, samples, stats) if self.then is not None else None
+        eps = list(getattr(stats, "episodes", []) or [])
+        values = self.row(eps, stats) if self.row is not None else [mean_of(eps, c) for c in self.columns]
+        row = [float(samples)] + [float(v) for v in values]
+        self.extra[self.key] = np.vstack([self.rows(), [row]])
+        if self.progress is not None:
+            self.progress(min(samples / max(self.total, 1), 1.0), self.message(row))
+        return out
+
+    def message(self, row: Sequence[float]) -> str:
+        """The progress line's figure for ``row`` (empty without ``shown``)."""
+        if self.shown is None:
+            return ""
+        from toolkit.execution.progress import figure
+
+        column, fmt, *missing = self.shown
+        value = row[1 + self.columns.index(column)]
+        return f"{column} {figure(value, fmt, *missing)}"
+
+    def curves(self, extra: Mapping, names: Optional[Mapping[str, str]] = None,
+               prefix: str = "") -> dict[str, list[tuple[int, float]]]:
+        """``{name: [(samples, value), ...]}`` per column (finite values only), for an
+        ``Evaluation``'s history; ``names`` renames columns, ``prefix`` goes before the others."""
+        rows = self.rows(extra)
+        names = dict(names or {})
+        return {names.get(c, prefix + c): [(int(r[0]), float(r[i])) for r in rows if math.isfinite(r[i])]
+                for i, c in enumerate(self.columns, start=1)}
