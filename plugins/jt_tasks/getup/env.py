@@ -109,8 +109,6 @@ class GetupEnv(CharacterEnv):
     CAMERA = {"distance": 2.4, "yaw": 30.0, "pitch": -28.0}
 
     def setup(self) -> None:
-        from toolkit import plugins
-
         spec = self.spec_
         self.curves = [FeatureCurve.from_dict(c) for c in spec.curves]
         if not self.curves:
@@ -119,8 +117,7 @@ class GetupEnv(CharacterEnv):
         self.control_hz = float(self.sim.control_hz)
         self.dt = 1.0 / self.control_hz
         self._m = self._lv = self._ahead = None  # this state's measurements, link velocities, targets
-        terms = dict((spec.reward or {}).get("terms") or {})
-        self.terms = {str(k): plugins.load("reward", str(k))(v) for k, v in terms.items()}
+        self.terms = self.load_terms((spec.reward or {}).get("terms"))
         self.natural = set(spec.natural_terms)
         q_stand, qd_stand = clip_pose("getup_facedown", False, frame=-1)
         self.stand_state = (q_stand, np.zeros_like(qd_stand))
@@ -354,7 +351,7 @@ class GetupEnv(CharacterEnv):
         self._m = self._lv = self._ahead = None
         spec = self.spec_
         if rec["failed"]:
-            return 0.0, True, False, self._final(f"simulator: {rec['reason']}", False)
+            return 0.0, True, False, self._final(self.failure(rec), False)
         record = self.record_now()
         values = {k: float(term(record)) for k, term in self.terms.items()}
         r_task = math.prod(v for k, v in values.items() if k not in self.natural)

@@ -90,12 +90,9 @@ class JumpEnv(CharacterEnv):
 
     # ------------------------------------------------------------------ set-up (scene, initial state)
     def setup(self) -> None:
-        from toolkit import plugins
-
         spec = self.spec_
         self.foot_link = FOOT_LINKS[spec.foot]
-        self.terms = {name: plugins.load("reward", name)(params)
-                      for name, params in (spec.reward_terms or {}).items()}
+        self.terms = self.load_terms(spec.reward_terms)
         self.suite = Suite(self.sim, spec.suite)
         feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
         if spec.takeoff_file:
@@ -212,7 +209,7 @@ class JumpEnv(CharacterEnv):
             m[:, :2].T.reshape(-1), R.T @ qd[:3], R.T @ qd[3:6], q[7:], qd[6:], rel.reshape(-1),
             [self.difficulty, self.t / self.spec_.time_limit],
         ]
-        return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
+        return self.flat(parts)
 
     # ------------------------------------------------------------------ episode
     def start(self, options: Optional[dict]) -> dict:
@@ -233,9 +230,7 @@ class JumpEnv(CharacterEnv):
         mat = rec["touched"].get(self.suite.mat_id)
         if mat is not None and not self.landed:
             self.landed, self.head_first = True, HEAD_LINK in mat
-        status, reason = rec["outcome"], rec["reason"]
-        if rec["failed"]:
-            reason = f"simulator: {reason}"
+        status, reason = rec["outcome"], self.failure(rec) or rec["reason"]
         w = rec["qd"][3:6]  # the step record's state is the simulator's state now
         self._ang_speeds.append(math.sqrt(w.dot(w)))  # np.linalg.norm's own sum, without its overhead
         if not status:

@@ -114,6 +114,25 @@ class CharacterEnv(gymnasium.Env):
         return None
 
     # ------------------------------------------------------------------ shared machinery
+    @staticmethod
+    def flat(parts: Any) -> np.ndarray:
+        """An observation ``(obs_dim,)`` float32 from its blocks (scalars, sequences, arrays of
+        any shape), each flattened in order."""
+        return np.concatenate([np.asarray(x, dtype=np.float64).reshape(-1) for x in parts]).astype(np.float32)
+
+    @staticmethod
+    def load_terms(terms: Any) -> dict[str, Any]:
+        """``{name: jt.rewards term}`` built from ``{name: its parameters}`` through the registry."""
+        from toolkit import plugins
+
+        return {str(k): plugins.load("reward", str(k))(v) for k, v in dict(terms or {}).items()}
+
+    @staticmethod
+    def failure(rec: dict[str, Any]) -> str:
+        """``"simulator: <why>"`` when the step record says the simulation failed (NaN, exploded
+        state), else ``""``: one wording for every task's ``reason``."""
+        return f"simulator: {rec['reason']}" if rec["failed"] else ""
+
     def links_and_com(self) -> tuple[np.ndarray, np.ndarray]:
         """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)``."""
         pos, _ = self.sim.link_states()

@@ -119,7 +119,7 @@ class RunupEnv(CharacterEnv):
         left = (self.total_substeps - self.substeps_done) / (self.sim_hz * self.ref.period)
         parts = [[q[1]], rot.quat_to_6d(r_local), rot.quat_rotate(inv, qd[:3]), rot.quat_rotate(inv, qd[3:6]),
                  q[7:], qd[6:], rel.reshape(-1), [math.sin(ph), math.cos(ph), left]]
-        return np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1) for p in parts]).astype(np.float32)
+        return self.flat(parts)
 
     def imitation(self) -> dict[str, float]:
         """The imitation terms (``reward.imitation_terms``) of the current state vs the reference."""
@@ -144,11 +144,7 @@ class RunupEnv(CharacterEnv):
 
     def finish_step(self, rec: dict[str, Any]) -> tuple[float, bool, bool, dict]:
         self.substeps_done += int(rec["substeps"])
-        reason = ""
-        if rec["failed"]:
-            reason = f"simulator: {rec['reason']}"
-        elif rec["outcome"]:
-            reason = rec["reason"]
+        reason = self.failure(rec) or (rec["reason"] if rec["outcome"] else "")
         if reason.startswith("simulator"):  # NaN / exploded state: nothing to compare
             terms = {k: 0.0 for k in ("pose", "vel", "ee", "com", "imitation")}
         else:

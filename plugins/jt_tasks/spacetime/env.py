@@ -308,7 +308,7 @@ class SpacetimeEnv(CharacterEnv):
         outcome, reason = rec["outcome"], ""
         reward, terminated, truncated = 0.0, False, False
         if rec["failed"]:
-            terminated, reason = True, f"simulator: {rec['reason']}"
+            terminated, reason = True, self.failure(rec)
         elif self.evaluating:
             reward = 1.0
             terminated, truncated = outcome == "fail", outcome == "truncate"
