@@ -52,7 +52,7 @@ class BulletSimulator(SceneQueries, Simulator):
         import pybullet as pb
 
         from toolkit import plugins
-        from toolkit.dynamics.bullet_io import PYBULLET_MAX_Q, BulletBody
+        from jt_bullet.body import PYBULLET_MAX_Q, BulletBody
         from toolkit.errors import JtError
         from jt_bullet import scene
 
@@ -158,6 +158,14 @@ class BulletSimulator(SceneQueries, Simulator):
             cls.load_character(cc, client)
         finally:
             pb.disconnect(client)
+
+    @classmethod
+    def spd_bench(cls) -> Any:
+        """The SPD benchmark of this simulator's characters (``jt bench spd``): the module
+        ``jt_bullet.bench`` (``time_spd``, ``check_agreement``, ``summarize``)."""
+        from jt_bullet import bench
+
+        return bench
 
     @classmethod
     def load_character(cls, name: Any, client: Any, **kw: Any) -> Any:
