@@ -18,19 +18,17 @@ from toolkit.motion.skeletons import Skeleton
 
 
 @contextlib.contextmanager
-def bullet_character(skeleton: Skeleton, client: int | None = None) -> Iterator[tuple[int, int]]:
-    """A PyBullet DIRECT client (or the given one) with the skeleton's URDF loaded.
+def bullet_character(skeleton: Skeleton) -> Iterator[tuple[int, int]]:
+    """A private PyBullet DIRECT client with the skeleton's URDF loaded.
 
     Yields:
-        ``(client id, body id)``; a client opened here is disconnected on exit, a body loaded
-        into a given client is removed.
+        ``(client id, body id)``; the client is disconnected on exit.
     """
     import pybullet as pb
 
     from toolkit.motion.skeletons import data_dir
 
-    own = client is None
-    cid = pb.connect(pb.DIRECT) if own else client
+    cid = pb.connect(pb.DIRECT)
     try:
         pb.setAdditionalSearchPath(data_dir(), physicsClientId=cid)
         from toolkit.quiet import native_stderr_silenced
@@ -40,14 +38,9 @@ def bullet_character(skeleton: Skeleton, client: int | None = None) -> Iterator[
                 skeleton.urdf, globalScaling=skeleton.scale, useFixedBase=False,
                 flags=pb.URDF_MAINTAIN_LINK_ORDER, physicsClientId=cid,
             )  # fmt: skip
-        try:
-            yield cid, body
-        finally:
-            if not own:
-                pb.removeBody(body, physicsClientId=cid)
+        yield cid, body
     finally:
-        if own:
-            pb.disconnect(cid)
+        pb.disconnect(cid)
 
 
 def forward_kinematics(
@@ -55,7 +48,6 @@ def forward_kinematics(
     root_pos: np.ndarray,
     root_rot: np.ndarray,
     joints: np.ndarray,
-    client: int | None = None,
 ) -> Kinematics:
     """Link poses of each pose by PyBullet (``resetBasePositionAndOrientation``,
     ``resetJointStatesMultiDof``, ``getLinkStates``): PyBullet is the reference, not a re-derivation.
@@ -65,7 +57,6 @@ def forward_kinematics(
         root_pos: root (base) positions ``(n, 3)``.
         root_rot: root orientations ``x, y, z, w`` ``(n, 4)``.
         joints: poses in the quaternion layout ``(n, n_q)``.
-        client: an existing PyBullet client to use; a private DIRECT one when ``None``.
 
     Returns:
         ``Kinematics`` with arrays ``(n, n_links, ...)``.
@@ -82,7 +73,7 @@ def forward_kinematics(
     indices = [j.bullet_index for j in skeleton.joints]
     slices = list(skeleton.q_slices.values())
     link_ids = list(range(n_links))
-    with bullet_character(skeleton, client) as (cid, body):
+    with bullet_character(skeleton) as (cid, body):
         n_urdf = pb.getNumJoints(body, physicsClientId=cid)
         if n_urdf != n_links:
             raise RuntimeError(f"{skeleton.urdf} has {n_urdf} links, the {skeleton.name} table {n_links}")
