@@ -53,10 +53,10 @@ def bench_spd(
 ) -> None:
     """Time the SPD solve and the whole simulation step per model and backend (thesis Tables 2.2/2.3)."""
     from toolkit import plugins
-    from toolkit.dynamics import bench
 
     model_list = _split(models, MODELS, "model")
-    loader = plugins.load("sim", "bullet").load_character  # characters through the registry
+    sim = plugins.load("sim", "bullet")  # the benchmark and its characters through the registry
+    bench, loader = sim.spd_bench(), sim.load_character
     if check:
         worst = bench.check_agreement(model_list, n_states=20, seed=seed, loader=loader)
         typer.echo(f"largest relative torque difference between backends: {worst:.3e} (limit 1e-8)")

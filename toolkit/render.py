@@ -1,6 +1,7 @@
-"""Headless rendering with PyBullet's TinyRenderer (no display), to PNG filmstrips and GIF/MP4.
+"""Rendered frames to files: PNG filmstrips and GIF/MP4 animations; the ``Camera`` a frame is taken by.
 
-In toolkit because simulators, tasks and the priors all render, and plugins cannot share code.
+In toolkit because simulators, tasks and the priors all render, and plugins cannot share code. The
+frames come from the simulator (``Simulator.render``, ``Simulator.render_poses``).
 
 Frames are RGB arrays ``(height, width, 3)`` uint8. The camera follows a target point and looks
 at it from the side in jt's y-up world (DeepMimic convention): the character runs along +x, so the
@@ -33,27 +34,6 @@ class Camera:
     pitch: float = -10.0
     fov: float = 60.0
     up_axis: int = 1
-
-
-def render_frame(client: int, target: Sequence[float], width: int = 320, height: int = 240,
-                 camera: Camera | None = None, body: int | None = None) -> Any:
-    """One RGB frame ``(height, width, 3)`` uint8 from TinyRenderer, looking at ``target``; with
-    ``body``, ``(frame, mask)``: the pixels that show that body, ``(height, width)`` bool."""
-    import pybullet as p
-
-    cam = camera or Camera()
-    view = p.computeViewMatrixFromYawPitchRoll(
-        cameraTargetPosition=list(map(float, target)), distance=cam.distance, yaw=cam.yaw,
-        pitch=cam.pitch, roll=0.0, upAxisIndex=cam.up_axis, physicsClientId=client)
-    proj = p.computeProjectionMatrixFOV(fov=cam.fov, aspect=width / height, nearVal=0.05, farVal=50.0,
-                                        physicsClientId=client)
-    _, _, rgba, _, seg = p.getCameraImage(width, height, view, proj, renderer=p.ER_TINY_RENDERER,
-                                          physicsClientId=client)
-    rgb = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
-    if body is None:
-        return rgb
-    ids = np.asarray(seg, dtype=np.int64).reshape(height, width)
-    return rgb, (ids >= 0) & ((ids & ((1 << 24) - 1)) == int(body))
 
 
 def filmstrip(frames: Sequence[np.ndarray], columns: int = 0, gap: int = 2) -> np.ndarray:

@@ -5,7 +5,7 @@ World convention: y-up, as the DeepMimic data (gravity ``(0, -9.8, 0)`` is the c
 
 Every loader disables PyBullet's default joint motors (so torques are the only actuation) and sets
 link/joint damping to 0, so the simulated dynamics are exactly the rigid-body model that
-``toolkit.dynamics.Model.from_bullet`` reads; joint limits from the URDF are kept. Link inertias:
+``jt_bullet.model.model_from_bullet`` reads; joint limits from the URDF are kept. Link inertias:
 the humanoid is loaded as pybullet's DeepMimic environment does (PyBullet derives the inertia
 tensors from the collision shapes, masses from the URDF); the others with
 ``URDF_USE_INERTIA_FROM_FILE`` (the URDF's own tensors; for the snakes both are the same).
@@ -83,10 +83,16 @@ class Character:
 
     def model(self) -> Any:
         """The ``toolkit.dynamics.Model`` of this body."""
-        from toolkit.dynamics.model import Model
+        from jt_bullet.model import model_from_bullet
 
-        return Model.from_bullet(self.client, self.body_id, name=self.name,
+        return model_from_bullet(self.client, self.body_id, name=self.name,
                                  floating=not self.fixed_base)
+
+    def body_io(self) -> Any:
+        """A ``jt_bullet.body.BulletBody`` reading and driving this body through its model."""
+        from jt_bullet.body import BulletBody
+
+        return BulletBody(self.client, self.body_id, self.model())
 
 
 def _client_id(client: Any) -> int:
@@ -136,7 +142,7 @@ def _load(name: str, client: Any, urdf: str, pos: Any, orn: Any, fixed_base: boo
         lim += [t_lim] * n
     pos_c, orn_c = pb.getBasePositionAndOrientation(body, **kw)
     q = [] if fixed_base else list(pos_c) + list(orn_c)
-    for n in dofs:  # PyBullet loads every joint at zero (not read back: see bullet_io limits)
+    for n in dofs:  # PyBullet loads every joint at zero (not read back: see jt_bullet.body's limits)
         q += [0.0, 0.0, 0.0, 1.0] if n == 3 else [0.0]
     return Character(name=name, body_id=body, client=cid, kp=np.array(kp), kd=np.array(kd),
                      torque_limit=np.array(lim), joint_indices=joints, joint_dofs=dofs,

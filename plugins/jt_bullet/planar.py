@@ -100,9 +100,9 @@ class PlanarWorld:
     def model(self) -> Any:
         """The model's ``toolkit.dynamics.Model`` (fixed base; q layout = joint order; gravity
         read from the world now)."""
-        from toolkit.dynamics.model import Model
+        from jt_bullet.model import model_from_bullet
 
-        return Model.from_bullet(self.client, self.robot)
+        return model_from_bullet(self.client, self.robot)
 
     # ------------------------------------------------------------------ dynamics
     def set_gravity(self, g: float) -> None:

@@ -318,7 +318,8 @@ class SceneQueries:
         import pybullet as pb
 
         from jt_bullet.config import DEFAULT_CAMERA
-        from toolkit.render import Camera, render_frame
+        from jt_bullet.render import render_frame
+        from toolkit.render import Camera
 
         if camera is None:
             d, yaw, pitch = DEFAULT_CAMERA.get(self.char_cfg.name, (3.0, 0.0, -10.0))

@@ -52,7 +52,7 @@ class BulletSimulator(SceneQueries, Simulator):
         import pybullet as pb
 
         from toolkit import plugins
-        from toolkit.dynamics.bullet_io import PYBULLET_MAX_Q, BulletBody
+        from jt_bullet.body import PYBULLET_MAX_Q, BulletBody
         from toolkit.errors import JtError
         from jt_bullet import scene
 
@@ -158,6 +158,37 @@ class BulletSimulator(SceneQueries, Simulator):
             cls.load_character(cc, client)
         finally:
             pb.disconnect(client)
+
+    # ------------------------------------------------------------------ kinematics (no world)
+    @classmethod
+    def forward_kinematics(cls, skeleton: Any, root_pos: np.ndarray, root_rot: np.ndarray,
+                           joints: np.ndarray) -> Any:
+        """Link poses of mocap poses by PyBullet (``jt_bullet.kinematics.forward_kinematics``)."""
+        from jt_bullet.kinematics import forward_kinematics
+
+        return forward_kinematics(skeleton, root_pos, root_rot, joints)
+
+    @classmethod
+    def kinematic_body(cls, skeleton: Any) -> Any:
+        """A never-stepped copy of the skeleton's character (``jt_bullet.kinematics.KinematicBody``)."""
+        from jt_bullet.kinematics import KinematicBody
+
+        return KinematicBody(skeleton)
+
+    @classmethod
+    def render_poses(cls, skeleton: Any, dofs: np.ndarray, **kw: Any) -> list:
+        """Still poses ``(n, n_dof)`` by TinyRenderer (``jt_bullet.render.render_poses``)."""
+        from jt_bullet.render import render_poses
+
+        return render_poses(skeleton, dofs, **kw)
+
+    @classmethod
+    def spd_bench(cls) -> Any:
+        """The SPD benchmark of this simulator's characters (``jt bench spd``): the module
+        ``jt_bullet.bench`` (``time_spd``, ``check_agreement``, ``summarize``)."""
+        from jt_bullet import bench
+
+        return bench
 
     @classmethod
     def load_character(cls, name: Any, client: Any, **kw: Any) -> Any:

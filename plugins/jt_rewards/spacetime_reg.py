@@ -48,7 +48,7 @@ def clip_statistics(clip: str) -> dict[str, np.ndarray]:
     ``(F,)`` m/s² (absolute), ``body_acc`` ``(F, n_bodies)`` m/s² (``|a_b − a_com|``), ``joint_acc``
     ``(F, n_joints)`` rad/s² (internal joints with dofs)."""
     from toolkit.motion import load_clip
-    from toolkit.motion.kinematics import KinematicBody, clip_velocities, forward_kinematics
+    from toolkit.motion.kinematics import clip_velocities, forward_kinematics, kinematic_body
     from toolkit.motion.skeletons import motions_dir
 
     import os
@@ -61,7 +61,7 @@ def clip_statistics(clip: str) -> dict[str, np.ndarray]:
         raise JtError(f"spacetime_reg.clip={clip!r}: no such clip; give a path or one of: {', '.join(known)}")
     c = load_clip(path, "humanoid")
     kin = forward_kinematics(c.skeleton, c.root_pos, c.root_rot, c.joints)
-    body = KinematicBody(c.skeleton)
+    body = kinematic_body(c.skeleton)
     try:
         masses = np.asarray(body.masses, dtype=float)
     finally:

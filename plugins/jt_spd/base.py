@@ -15,7 +15,7 @@ class ToolkitSPD(SPDBackend):
         backend.bind(model)                        # once (a toolkit.dynamics.Model or Character)
         tau = backend.torques(q, qd, q_target, kp, kd, dt)   # then clip, apply, stepSimulation
 
-    or ``backend.control(io, ...)`` with a ``toolkit.dynamics.bullet_io.BulletBody`` to read the
+    or ``backend.control(io, ...)`` with the simulator's body I/O (``sim=bullet``'s ``BulletBody``) to read the
     state, solve, clip and apply in one call. ``torques`` returns an internal buffer that the next
     call overwrites (copy it to keep it).
     """

@@ -43,14 +43,13 @@ class BulletBackend(SPDBackend):
         self.io: Any = None
 
     def bind(self, body: Any) -> None:
-        """Attach to a PyBullet body: a ``toolkit.dynamics.bullet_io.BulletBody`` or a Character."""
-        from toolkit.dynamics.bullet_io import BulletBody
-
-        if isinstance(body, BulletBody):
+        """Attach to a PyBullet body: ``sim=bullet``'s ``BulletBody`` (what has ``stable_pd``) or a
+        Character (what has ``body_io``); the simulator plugin owns both, so none is imported."""
+        if hasattr(body, "stable_pd"):
             self.io = body
             return
-        if hasattr(body, "body_id") and hasattr(body, "client"):
-            self.io = BulletBody(body.client, body.body_id, body.model())
+        if hasattr(body, "body_io"):
+            self.io = body.body_io()
             return
         raise TypeError("bullet SPD needs a BulletBody or a Character (a PyBullet body), "
                         f"got {type(body).__name__}")

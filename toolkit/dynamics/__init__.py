@@ -2,8 +2,8 @@
 
 Algorithms, one module each: ``crba`` (mass matrix), ``rnea`` (inverse dynamics, bias forces),
 ``aba`` (forward dynamics), ``maba`` (SPD in O(n), thesis ``001`` §2.3), ``sparse_ltl`` (the SF
-factorisation), ``dense`` (DF Cholesky), ``pcg`` (Jacobi-PCG), ``spd`` (public SPD API),
-``bench`` (timings). Kernels are numba ``@njit(cache=True)`` functions compiled on first call;
+factorisation), ``dense`` (DF Cholesky), ``pcg`` (Jacobi-PCG), ``spd`` (public SPD API).
+A simulator plugin builds the ``Model`` of its bodies and times these (``jt bench spd``). Kernels are numba ``@njit(cache=True)`` functions compiled on first call;
 importing this package imports nothing heavy (names below load their module on first access).
 The algorithm functions share their module's name: ``from toolkit.dynamics.crba import crba``.
 """

@@ -5,7 +5,7 @@ parent's frame to body ``i``'s (``p_i = E_i (p_parent - r_i)``); composing them 
 world rotation ``E^w_i = E_i E^w_parent`` and origin ``o^w_i = o^w_parent + E^{w T}_parent r_i``,
 and the body's centre of mass in the world is ``o^w_i + E^{w T}_i c_i``. The whole-body CoM is the
 mass-weighted mean. Bodies merged through fixed joints carry their combined mass and CoM
-(``Model.from_bullet``), so the result equals PyBullet's link-by-link mean.
+(as the simulator plugin builds the ``Model``), so the result equals PyBullet's link-by-link mean.
 """
 
 from __future__ import annotations

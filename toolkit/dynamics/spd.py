@@ -1,4 +1,4 @@
-"""Stable PD torques for any PyBullet body: the public API of ``toolkit.dynamics``.
+"""Stable PD torques for any articulated body: the public API of ``toolkit.dynamics``.
 
 Four methods solve the same SPD system (thesis eq 2.7, see ``toolkit.dynamics.maba``)
 
@@ -11,10 +11,9 @@ Four methods solve the same SPD system (thesis eq 2.7, see ``toolkit.dynamics.ma
 
 Example::
 
-    import pybullet as p
-    from toolkit.dynamics import Model, Data, spd_torques
+    from toolkit.dynamics import Data, spd_torques
 
-    model = Model.from_bullet(client, body)          # once
+    model = character.model()                        # once (a simulator plugin builds it)
     data = Data(model)                               # once per thread
     tau = spd_torques(model, data, q, qd, q_target, kp, kd, dt=1 / 600)
 
@@ -129,7 +128,7 @@ def spd_torques(model: "Model", data: "Data", q: np.ndarray, qd: np.ndarray,
     """Stable PD generalised forces for targets one step ahead (thesis eq 2.4 / 2.6).
 
     Args:
-        model: the articulated body (``Model.from_bullet``).
+        model: the articulated body (a ``Model``).
         data: its workspace (``Data(model)``).
         q: positions ``(n_q,)``.
         qd: velocities ``(n_v,)``.

@@ -91,6 +91,17 @@ class Simulator(Plugin, abc.ABC):
         planar_world: optional classmethod ``planar_world(urdf_path, sim_hz, friction, ...)``
             opening a planar (2-D) world for ``task=standing_jump``; None (default): this
             simulator has none, and that task says so.
+        forward_kinematics: optional classmethod ``forward_kinematics(skeleton, root_pos,
+            root_rot, joints) -> toolkit.motion.kinematics.Kinematics``: link poses of mocap
+            poses ``(n, ...)`` of a ``toolkit.motion.Skeleton``'s character, no world needed.
+            ``toolkit.motion`` (features, datasets) and the tasks' references use the first
+            registered simulator that has it (``toolkit.motion.kinematics.engine``). None: none.
+        kinematic_body: optional classmethod ``kinematic_body(skeleton)``: a kinematic copy of
+            the character, never stepped (``masses``, ``pose(q)``, ``lowest_point(q, link)``,
+            ``links_and_com(q)``, ``close()``; see ``toolkit.motion.kinematics.kinematic_body``).
+        render_poses: optional classmethod ``render_poses(skeleton, dofs) -> list`` of RGB frames
+            ``(height, width, 3)`` uint8 of still poses in the dof layout ``(n, n_dof)`` (the
+            priors' filmstrips, ``toolkit.priors.render``).
 
     Required: ``sim_hz``, ``control_hz``, ``reset``, ``step``, ``state`` and the queries and scene methods below that a task
     uses (the defaults raise ``NotImplementedError``); ``close`` releases the engine.
@@ -105,6 +116,9 @@ class Simulator(Plugin, abc.ABC):
     n_links: int = 0
     steps_itself: bool = False
     planar_world: ClassVar[Optional[Callable[..., Any]]] = None
+    forward_kinematics: ClassVar[Optional[Callable[..., Any]]] = None
+    kinematic_body: ClassVar[Optional[Callable[..., Any]]] = None
+    render_poses: ClassVar[Optional[Callable[..., Any]]] = None
     group_schemas: ClassVar[dict[str, type]] = {}
 
     def __init__(self, cfg: Any) -> None:

@@ -30,8 +30,8 @@ class SPDBackend(GroupPlugin, abc.ABC):
     Attributes:
         steps_itself: False (default): ``torques`` returns the SPD torques, which the caller clips
             and applies before stepping the engine. True: the backend acts inside the engine's own
-            step (PyBullet's STABLE_PD: ``spd=bullet``): it is bound to the engine's body (a
-            ``toolkit.dynamics.bullet_io.BulletBody``) instead of a ``Model``, the simulator calls
+            step (PyBullet's STABLE_PD: ``spd=bullet``): it is bound to the engine's body (the
+            simulator's body I/O object, see ``control``) instead of a ``Model``, the simulator calls
             ``apply`` before every substep, and ``torques`` may raise ``NotImplementedError``.
 
     Args:
@@ -83,7 +83,8 @@ class SPDBackend(GroupPlugin, abc.ABC):
 
     def control(self, io: Any, q_target: "np.ndarray", kp: "np.ndarray", kd: "np.ndarray", dt: float,
                 torque_limit: "np.ndarray", qd_target: "np.ndarray | None" = None) -> Any:
-        """One substep's control of a PyBullet body ``io`` (a ``toolkit.dynamics.bullet_io.BulletBody``):
+        """One substep's control of a body through the simulator's body I/O object ``io``
+        (``io.read() -> (q, qd)``, ``io.write_torques(tau)``; ``sim=bullet``'s ``BulletBody``):
         read the state, compute the torques, clip them to ``±torque_limit`` and write them; the
         caller then steps the engine. Returns the applied torques ``(n_dof,)``."""
         import numpy as np

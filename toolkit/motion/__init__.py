@@ -2,8 +2,9 @@
 
 Conventions (docs/motion.md): quaternions ``x, y, z, w``; the world as in the data (y-up for
 the DeepMimic humanoid, which faces +x with its right side towards +z). Submodules import numpy
-(and h5py / pybullet inside functions); ``rotations_torch`` is the only one importing torch and is
-not imported here.
+(and h5py inside functions); forward kinematics comes from a simulator plugin
+(``kinematics.engine``); ``rotations_torch`` is the only one importing torch and is not imported
+here.
 """
 
 from toolkit.motion.clips import Clip, ClipError, load_clip, load_humanoid_clips

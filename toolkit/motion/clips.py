@@ -154,11 +154,11 @@ class Clip:
 
         return clip_velocities(self)
 
-    def fk(self, client: int | None = None):
-        """Link positions and orientations by PyBullet; see ``kinematics.forward_kinematics``."""
+    def fk(self):
+        """Link positions and orientations of every frame; see ``kinematics.forward_kinematics``."""
         from toolkit.motion.kinematics import forward_kinematics
 
-        return forward_kinematics(self.skeleton, self.root_pos, self.root_rot, self.joints, client=client)
+        return forward_kinematics(self.skeleton, self.root_pos, self.root_rot, self.joints)
 
 
 # --------------------------------------------------------------------------- loading

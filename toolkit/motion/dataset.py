@@ -173,7 +173,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     """``python -m toolkit.motion.dataset OUT.h5 [--rate 30] [--no-mirror] [--held-out NAME ...]``."""
     import argparse
 
-    ap = argparse.ArgumentParser(description="Build jt's pose dataset from pybullet_data's humanoid clips.")
+    ap = argparse.ArgumentParser(description="Build jt's pose dataset from the humanoid clips shipped in pybullet_data.")
     ap.add_argument("out")
     ap.add_argument("--rate", type=float, default=DEFAULT_RATE)
     ap.add_argument("--no-mirror", action="store_true")

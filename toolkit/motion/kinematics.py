@@ -1,10 +1,14 @@
-"""Velocities (finite differences) and forward kinematics (PyBullet) of mocap poses."""
+"""Velocities (finite differences) and forward kinematics of mocap poses.
+
+Forward kinematics needs a physics engine's reading of the character's URDF: it comes from the
+registered simulator that provides it (the optional ``Simulator`` hooks ``forward_kinematics``,
+``kinematic_body`` and ``render_poses``, found by ``engine``); nothing here imports an engine.
+"""
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-from typing import TYPE_CHECKING, Iterator
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -87,133 +91,48 @@ class Kinematics:
         return self.links.index(name)
 
 
-@contextlib.contextmanager
-def bullet_character(skeleton: Skeleton, client: int | None = None) -> Iterator[tuple[int, int]]:
-    """A PyBullet DIRECT client (or the given one) with the skeleton's URDF loaded.
+def engine(hook: str = "forward_kinematics") -> Any:
+    """The registered simulator class that provides ``hook``: the first by name whose class has it.
 
-    Yields:
-        ``(client id, body id)``; a client opened here is disconnected on exit, a body loaded
-        into a given client is removed.
+    Args:
+        hook: a ``Simulator`` class hook: ``forward_kinematics``, ``kinematic_body`` or
+            ``render_poses``.
+
+    Raises:
+        toolkit.errors.JtError: no registered simulator provides it.
     """
-    import pybullet as pb
-    import pybullet_data
+    from toolkit import plugins
+    from toolkit.errors import JtError
 
-    own = client is None
-    cid = pb.connect(pb.DIRECT) if own else client
-    try:
-        pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=cid)
-        from toolkit.quiet import native_stderr_silenced
-
-        with native_stderr_silenced():  # the DeepMimic URDF warns once per spherical joint
-            body = pb.loadURDF(
-                skeleton.urdf, globalScaling=skeleton.scale, useFixedBase=False,
-                flags=pb.URDF_MAINTAIN_LINK_ORDER, physicsClientId=cid,
-            )  # fmt: skip
+    for name in plugins.names("sim"):
         try:
-            yield cid, body
-        finally:
-            if not own:
-                pb.removeBody(body, physicsClientId=cid)
-    finally:
-        if own:
-            pb.disconnect(cid)
+            cls = plugins.load("sim", name)
+        except JtError:  # a broken plugin (jt plugins lists it): the next one may do
+            continue
+        if getattr(cls, hook, None) is not None:
+            return cls
+    raise JtError(f"no registered simulator provides {hook} (Simulator.{hook}); mocap kinematics "
+                  f"need one (simulators: {', '.join(plugins.names('sim')) or 'none'})")
 
 
-def forward_kinematics(
-    skeleton: Skeleton,
-    root_pos: np.ndarray,
-    root_rot: np.ndarray,
-    joints: np.ndarray,
-    client: int | None = None,
-) -> Kinematics:
-    """Link poses of each pose by PyBullet (``resetBasePositionAndOrientation``,
-    ``resetJointStatesMultiDof``, ``getLinkStates``): PyBullet is the reference, not a re-derivation.
+def forward_kinematics(skeleton: Skeleton, root_pos: np.ndarray, root_rot: np.ndarray,
+                       joints: np.ndarray) -> Kinematics:
+    """Link poses of each pose, by the simulator that provides ``forward_kinematics``.
 
     Args:
         skeleton: the character.
         root_pos: root (base) positions ``(n, 3)``.
         root_rot: root orientations ``x, y, z, w`` ``(n, 4)``.
         joints: poses in the quaternion layout ``(n, n_q)``.
-        client: an existing PyBullet client to use; a private DIRECT one when ``None``.
 
     Returns:
         ``Kinematics`` with arrays ``(n, n_links, ...)``.
     """
-    import pybullet as pb
-
-    root_pos = np.atleast_2d(np.asarray(root_pos, dtype=np.float64))
-    root_rot = np.atleast_2d(np.asarray(root_rot, dtype=np.float64))
-    joints = np.atleast_2d(np.asarray(joints, dtype=np.float64))
-    n, n_links = root_pos.shape[0], len(skeleton.links)
-    com = np.empty((n, n_links, 3))
-    org = np.empty((n, n_links, 3))
-    ori = np.empty((n, n_links, 4))
-    indices = [j.bullet_index for j in skeleton.joints]
-    slices = list(skeleton.q_slices.values())
-    link_ids = list(range(n_links))
-    with bullet_character(skeleton, client) as (cid, body):
-        n_urdf = pb.getNumJoints(body, physicsClientId=cid)
-        if n_urdf != n_links:
-            raise RuntimeError(f"{skeleton.urdf} has {n_urdf} links, the {skeleton.name} table {n_links}")
-        for i in range(n):
-            pb.resetBasePositionAndOrientation(body, root_pos[i].tolist(), root_rot[i].tolist(), physicsClientId=cid)
-            pb.resetJointStatesMultiDof(
-                body, indices, [joints[i, s].tolist() for s in slices], physicsClientId=cid
-            )
-            states = pb.getLinkStates(body, link_ids, computeForwardKinematics=True, physicsClientId=cid)
-            for k, st in enumerate(states):
-                com[i, k] = st[0]
-                org[i, k] = st[4]
-                ori[i, k] = st[5]
-    return Kinematics(tuple(skeleton.links), com, org, ori)
+    return engine("forward_kinematics").forward_kinematics(skeleton, root_pos, root_rot, joints)
 
 
-class KinematicBody:
-    """A kinematic copy of a skeleton's character in a private PyBullet DIRECT client (never
-    stepped): forward kinematics of poses for references and rewards.
-
-    Args:
-        skeleton: the character's skeleton (URDF, scale, joint layout).
-
-    Attributes:
-        masses: link masses ``(n_links + 1,)``, base first (kg).
-    """
-
-    def __init__(self, skeleton: Skeleton) -> None:
-        import pybullet as pb
-
-        self._pb = pb
-        self._stack = contextlib.ExitStack()
-        self.client, self.body = self._stack.enter_context(bullet_character(skeleton))
-        kw = {"physicsClientId": self.client}
-        n = pb.getNumJoints(self.body, **kw)
-        self.masses = np.array([pb.getDynamicsInfo(self.body, i, **kw)[0] for i in range(-1, n)])
-        self._indices = [j.bullet_index for j in skeleton.joints]
-        self._slices = list(skeleton.q_slices.values())
-
-    def pose(self, q: np.ndarray) -> None:
-        """Put the copy in pose ``q`` ``(n_q,)`` (``toolkit.dynamics`` layout)."""
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        q = np.asarray(q, dtype=float)
-        pb.resetBasePositionAndOrientation(self.body, q[:3].tolist(), q[3:7].tolist(), **kw)
-        pb.resetJointStatesMultiDof(self.body, self._indices, [q[7:][s].tolist() for s in self._slices], **kw)
-
-    def lowest_point(self, q: np.ndarray, link: int | None = None) -> float:
-        """Lowest height of a link's bounding box (None: of the whole body) in pose ``q``."""
-        self.pose(q)
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        links = [link] if link is not None else range(-1, len(self.masses) - 1)
-        return float(min(pb.getAABB(self.body, i, **kw)[0][1] for i in links))
-
-    def links_and_com(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Link centres of mass ``(n_links + 1, 3)`` (base first) and the CoM ``(3,)`` of pose ``q``."""
-        q = np.asarray(q, dtype=float)
-        self.pose(q)
-        pb, kw = self._pb, {"physicsClientId": self.client}
-        states = pb.getLinkStates(self.body, list(range(len(self.masses) - 1)), computeForwardKinematics=True, **kw)
-        links = np.array([q[:3]] + [s[0] for s in states], dtype=float)
-        return links, self.masses @ links / self.masses.sum()
-
-    def close(self) -> None:
-        """Disconnect the private client (idempotent)."""
-        self._stack.close()
+def kinematic_body(skeleton: Skeleton) -> Any:
+    """A kinematic copy of the skeleton's character (never stepped), by the simulator that provides
+    ``kinematic_body``: ``masses`` ``(n_links + 1,)``, ``pose(q)``, ``lowest_point(q, link=None)``,
+    ``links_and_com(q)`` and ``close()`` (``q`` in the ``toolkit.dynamics`` layout ``(n_q,)``)."""
+    return engine("kinematic_body").kinematic_body(skeleton)

@@ -59,7 +59,7 @@ class Skeleton:
 
     Attributes:
         name: ``"humanoid"`` or ``"laikago"``.
-        urdf: URDF path relative to ``pybullet_data.getDataPath()``.
+        urdf: URDF path relative to ``data_dir()``; ``urdf_path`` is the full path.
         scale: ``globalScaling`` to load the URDF with.
         joints: internal joints in file / layout order.
         links: PyBullet link names by link index (the base, index -1, is not listed).
@@ -87,6 +87,11 @@ class Skeleton:
     root_quat_order: str
     neck_link: str | None = None
     hip_links: tuple[str, str] | None = None
+
+    @property
+    def urdf_path(self) -> str:
+        """Full path of the character's URDF."""
+        return os.path.join(data_dir(), self.urdf)
 
     # ----------------------------------------------------------------- layout bookkeeping
     @property
@@ -282,11 +287,20 @@ LAIKAGO = _laikago()
 SKELETONS = {"humanoid": HUMANOID, "laikago": LAIKAGO}
 
 
+def data_dir() -> str:
+    """Folder of the ``pybullet_data`` package (the characters' URDFs, the DeepMimic clips): a data
+    location, found without importing anything (``pybullet_data.getDataPath()`` is this folder)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("pybullet_data")
+    if spec is None or not spec.submodule_search_locations:
+        raise FileNotFoundError("the pybullet_data package (jt's mocap clips and URDFs) is not installed")
+    return str(list(spec.submodule_search_locations)[0])
+
+
 def motions_dir() -> str:
     """Folder of the DeepMimic-format clips shipped with ``pybullet_data``."""
-    import pybullet_data
-
-    return os.path.join(pybullet_data.getDataPath(), "data", "motions")
+    return os.path.join(data_dir(), "data", "motions")
 
 
 def humanoid_clip_paths() -> list[str]:

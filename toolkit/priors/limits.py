@@ -4,7 +4,8 @@ The dof layout (``Skeleton.dof_slices``) holds an exponential map per spherical 
 per revolute joint. Limits:
 
 * revolute joints: the URDF's ``<limit lower upper>`` (humanoid knees ``[-3.14, 0]``, elbows
-  ``[0, 3.14]``), read once with PyBullet's ``getJointInfo``;
+  ``[0, 3.14]``), read once from the URDF file as PyBullet reads it (a ``continuous`` joint, or
+  ``lower >= upper``, has none);
 * spherical joints: each exp-map component in ``[-pi, pi]``, DeepMimic's convention for spherical
   joints (the URDF gives none). ``limit_targets`` maps every spherical target to its canonical exp
   map (``|v| <= pi``, the same rotation), which satisfies this, and clips revolute angles.
@@ -23,22 +24,40 @@ from toolkit.motion import rotations as rot
 from toolkit.motion.skeletons import SKELETONS, SPHERICAL, Skeleton
 
 
+def urdf_joint_limits(path: str) -> dict[str, tuple[float, float]]:
+    """``(lower, upper)`` of every limited revolute or prismatic joint of a URDF, by child link name.
+
+    Args:
+        path: the URDF file (trailing NUL bytes, as in ``pybullet_data``'s humanoid, are ignored).
+
+    Returns:
+        Child link name -> ``(lower, upper)`` for joints whose ``<limit>`` has ``lower < upper``
+        (``continuous`` joints and ``lower >= upper`` mean no limit, as in PyBullet).
+    """
+    import xml.etree.ElementTree as ET
+
+    with open(path, "rb") as f:
+        root = ET.fromstring(f.read().replace(b"\x00", b""))
+    out = {}
+    for joint in root.iter("joint"):
+        lim, child = joint.find("limit"), joint.find("child")
+        if joint.get("type") not in ("revolute", "prismatic") or lim is None or child is None:
+            continue
+        lo, hi = float(lim.get("lower", 0.0)), float(lim.get("upper", 0.0))
+        if lo < hi:
+            out[str(child.get("link"))] = (lo, hi)
+    return out
+
+
 @functools.lru_cache(maxsize=None)
 def _limits(skeleton_name: str) -> tuple[np.ndarray, np.ndarray]:
-    import pybullet as pb
-
-    from toolkit.motion.kinematics import bullet_character
-
     sk = SKELETONS[skeleton_name]
     low, high = np.full(sk.n_dof, -np.pi), np.full(sk.n_dof, np.pi)
-    with bullet_character(sk) as (cid, body):
-        for j, s in zip(sk.joints, sk.dof_slices.values()):
-            if j.kind == SPHERICAL:
-                continue
-            info = pb.getJointInfo(body, j.bullet_index, physicsClientId=cid)
-            lo, hi = float(info[8]), float(info[9])
-            if lo < hi:  # PyBullet reports lower > upper for a joint without limits
-                low[s], high[s] = lo, hi
+    urdf = urdf_joint_limits(sk.urdf_path)
+    for j, s in zip(sk.joints, sk.dof_slices.values()):
+        lim = urdf.get(sk.links[j.bullet_index]) if j.kind != SPHERICAL else None
+        if lim is not None:  # joint j moves link j (URDF_MAINTAIN_LINK_ORDER)
+            low[s], high[s] = lim
     low.setflags(write=False)
     high.setflags(write=False)
     return low, high

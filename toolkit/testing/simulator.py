@@ -3,7 +3,9 @@ searcher suites: stepping and time, the substep loop's termination rules (``Watc
 reads, contacts, scene geometry (boxes), rays and rendering — on the real engine.
 
 A subclass sets ``make()`` (a simulator of the humanoid with 600 Hz substeps) and inherits the
-tests. States come from the DeepMimic run clip (``standing``: a mid-support frame, feet down)::
+tests. States come from the hook ``run_state(sim)``: by default the DeepMimic run clip's
+mid-support frame (feet down), found by the simulator under test's own forward kinematics, so the
+suite needs nothing but the simulator (override it to give another state)::
 
     from toolkit.testing.simulator import SimulatorContract
 
@@ -24,27 +26,33 @@ import pytest
 from toolkit.interfaces.simulator import BASE, ContactRule, Simulator, Watch
 
 
-def run_state() -> tuple[np.ndarray, np.ndarray]:
-    """The run clip's frame whose right ankle is lowest (the stance foot on the ground), with its
-    velocities (``toolkit.dynamics`` layout); from ``toolkit.motion`` alone, so a third party's
-    simulator runs this suite without jt's plugins."""
-    from toolkit.motion import load_clip
-    from toolkit.motion.kinematics import clip_velocities, forward_kinematics
-    from toolkit.motion.skeletons import motions_dir
-
-    clip = load_clip(f"{motions_dir()}/humanoid3d_run.txt")
-    kin = forward_kinematics(clip.skeleton, clip.root_pos, clip.root_rot, clip.joints)
-    i = int(np.argmin(kin.joint_pos[:, kin.links.index("right_ankle"), 1]))
-    vel = clip_velocities(clip)
-    return (np.concatenate([clip.root_pos[i], clip.root_rot[i], clip.joints[i]]),
-            np.concatenate([vel.root_lin[i], vel.root_ang[i], vel.joints[i]]))
-
-
 class SimulatorContract:
     """Tests every simulator must pass (subclass it as ``TestXxx`` and define ``make``)."""
 
     def make(self, **sim: Any) -> Any:  # pragma: no cover - abstract
         raise NotImplementedError
+
+    def run_state(self, sim: Simulator) -> tuple[np.ndarray, np.ndarray]:
+        """The hook: a humanoid state ``(q, qd)`` (``toolkit.dynamics`` layout) with the stance foot
+        down. Default: the run clip's frame whose right ankle is lowest by ``sim``'s own forward
+        kinematics (``reset`` to each frame, ``link_pose``), with its velocities
+        (``toolkit.motion.kinematics.clip_velocities``); ``sim`` is left in that pose at rest."""
+        from toolkit.motion import load_clip
+        from toolkit.motion.kinematics import clip_velocities
+        from toolkit.motion.skeletons import motions_dir
+
+        clip = load_clip(f"{motions_dir()}/humanoid3d_run.txt")
+        ankle = sim.link_index("right_ankle")
+        poses = [np.concatenate([clip.root_pos[i], clip.root_rot[i], clip.joints[i]])
+                 for i in range(clip.n_frames)]
+        heights = []
+        for q in poses:
+            sim.reset(q, np.zeros(sim.model.n_v))
+            heights.append(float(sim.link_pose(ankle)[0][1]))
+        i = int(np.argmin(heights))
+        sim.reset(poses[i], np.zeros(sim.model.n_v))
+        vel = clip_velocities(clip)
+        return poses[i], np.concatenate([vel.root_lin[i], vel.root_ang[i], vel.joints[i]])
 
     @pytest.fixture()
     def sim(self):
@@ -53,7 +61,7 @@ class SimulatorContract:
         s.close()
 
     def _lifted(self, sim, height: float = 0.0):
-        q, qd = run_state()
+        q, qd = self.run_state(sim)
         sim.reset(q, np.zeros_like(qd))
         low = min(sim.aabb(i)[0][1] for i in range(BASE, sim.n_links))
         q = q.copy()
@@ -63,7 +71,7 @@ class SimulatorContract:
 
     # ------------------------------------------------------------------ state, time
     def test_reset_then_state_round_trips(self, sim):
-        q, qd = run_state()
+        q, qd = self.run_state(sim)
         sim.reset(q, qd)
         q2, qd2 = sim.state()
         np.testing.assert_allclose(q2[:3], q[:3], atol=1e-9)
@@ -129,7 +137,7 @@ class SimulatorContract:
         assert lin[0, 1] < -0.1  # falling
         np.testing.assert_allclose(lin, np.broadcast_to(qd[:3], lin.shape), atol=2e-3)
         np.testing.assert_allclose(ang, 0.0, atol=2e-2)
-        q, qd = run_state()
+        q, qd = self.run_state(sim)
         q = q.copy()
         q[1] += 0.5
         sim.reset(q, qd)
@@ -145,7 +153,7 @@ class SimulatorContract:
     def test_link_index_and_link_pose_are_forward_kinematics_of_the_reset_state(self, sim):
         from toolkit.errors import JtError
 
-        q, qd = run_state()
+        q, qd = self.run_state(sim)
         sim.reset(q, np.zeros_like(qd))
         assert sim.link_index("base") == BASE
         ankle = sim.link_index("right_ankle")

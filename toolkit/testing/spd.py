@@ -8,14 +8,21 @@ SPD from ``toolkit.dynamics``) and inherits every test::
     class TestMyBackend(SPDBackendSuite):
         backend_cls = MyBackend
 
-The worlds are PyBullet bodies of jt's built-in characters (``jt_bullet.characters``, imported
-when a test builds one); ``make()`` builds the backend (``backend_cls(None)`` by default).
+The worlds come from the subclass: ``make_world(name, plane)`` returns an ``SPDWorld`` (the body's
+``Model``, its I/O, gains and standing pose), so the suite runs on any simulator; this module
+imports none. jt's own test modules take them from PyBullet (``jt_bullet.testing.BulletSPDWorlds``,
+a mixin)::
+
+    class TestMyBackend(BulletSPDWorlds, SPDBackendSuite):
+        backend_cls = MyBackend
+
+``make()`` builds the backend (``backend_cls(None)`` by default).
 """
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, ClassVar
+from typing import Any, Callable, ClassVar
 
 import numpy as np
 import pytest
@@ -23,26 +30,30 @@ import pytest
 DT = 1.0 / 600.0
 
 
-def make_world(name: str, fixed: bool = False, plane: bool = False, **kw: Any) -> tuple:
-    """(client, Character, BulletBody) in a fresh DIRECT client, y-up gravity."""
-    import math
+@dataclasses.dataclass
+class SPDWorld:
+    """One character in a world of its own: what the suite drives a backend on.
 
-    import pybullet as pb
-    import pybullet_data
+    Attributes:
+        model: the body's ``toolkit.dynamics.Model``.
+        io: the simulator's body I/O: ``read() -> (q, qd)``, ``reset(q, qd)``,
+            ``write_torques(tau)``, ``step()``; a ``steps_itself`` backend binds to it.
+        q_init: the character's standing pose ``(n_q,)``.
+        kp: stiffness per DoF ``(n_v,)``.
+        kd: damping per DoF ``(n_v,)``.
+        torque_limit: torque limit per DoF ``(n_v,)``.
+        close: releases the world.
+        character: the simulator's own handle of the body, for a subclass's own tests (or None).
+    """
 
-    from jt_bullet.characters import load
-    from toolkit.dynamics.bullet_io import BulletBody
-
-    c = pb.connect(pb.DIRECT)
-    pb.setGravity(0, -9.8, 0, physicsClientId=c)
-    pb.setTimeStep(DT, physicsClientId=c)
-    if plane:
-        pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
-        z2y = pb.getQuaternionFromEuler([-math.pi * 0.5, 0, 0])
-        pb.loadURDF("plane_implicit.urdf", [0, 0, 0], z2y, useMaximalCoordinates=True,
-                    physicsClientId=c)
-    ch = load(name, c, fixed_base=fixed, **kw)
-    return c, ch, BulletBody(c, ch.body_id, ch.model())
+    model: Any
+    io: Any
+    q_init: np.ndarray
+    kp: np.ndarray
+    kd: np.ndarray
+    torque_limit: np.ndarray
+    close: Callable[[], None]
+    character: Any = None
 
 
 class SPDBackendSuite:
@@ -51,14 +62,22 @@ class SPDBackendSuite:
     backend_cls: ClassVar[type] = None  # type: ignore[assignment]
     #: torques equal toolkit.dynamics' exact SPD (False for PyBullet's own controller)
     reference_exact: ClassVar[bool] = True
+    #: characters whose torques ``test_torques_match_exact_spd`` compares (names ``make_world`` knows)
+    exact_bodies: ClassVar[tuple[str, ...]] = ("humanoid", "snake36", "atlas")
+
+    def make_world(self, name: str, plane: bool = False) -> SPDWorld:
+        """The hook: character ``name`` (``"humanoid"``: floating base, y-up; and the
+        ``exact_bodies``) alone in a fresh world with gravity ``(0, -9.8, 0)`` and time step ``DT``,
+        on a ground plane at height 0 when ``plane``."""
+        raise NotImplementedError(
+            f"{type(self).__name__}: SPDBackendSuite needs worlds; define make_world(name, plane) "
+            "returning an SPDWorld (jt's PyBullet ones: jt_bullet.testing.BulletSPDWorlds)")
 
     @pytest.fixture(scope="class")
     def humanoid(self) -> Any:
-        import pybullet as pb
-
-        world = make_world("humanoid", plane=True)
+        world = self.make_world("humanoid", plane=True)
         yield world
-        pb.disconnect(world[0])
+        world.close()
 
     def make(self) -> Any:
         return self.backend_cls(None)
@@ -85,43 +104,41 @@ class SPDBackendSuite:
     # ---- behaviour ---------------------------------------------------------------------------
     def test_holds_the_humanoid_standing(self, humanoid):
         """Tracking the loaded pose for 0.5 s on the ground: stays upright, no NaN."""
-        c, ch, io = humanoid
+        w = humanoid
+        io = w.io
         backend = self.make()
-        backend.bind(io if self.backend_cls.steps_itself else ch.model())
-        io.reset(ch.q_init, np.zeros(ch.n_dof))
+        backend.bind(io if self.backend_cls.steps_itself else w.model)
+        io.reset(w.q_init, np.zeros(w.model.n_v))
         for _ in range(300):
-            backend.control(io, ch.q_init, ch.kp, ch.kd, DT, ch.torque_limit)
+            backend.control(io, w.q_init, w.kp, w.kd, DT, w.torque_limit)
             io.step()
         q, qd = io.read()
         assert np.all(np.isfinite(q)) and np.all(np.isfinite(qd))
-        assert abs(q[1] - ch.q_init[1]) < 0.05  # root height (y-up) within 5 cm
+        assert abs(q[1] - w.q_init[1]) < 0.05  # root height (y-up) within 5 cm
         assert np.abs(qd).max() < 1.0
 
     def test_torques_match_exact_spd(self):
         if not self.reference_exact:
             pytest.skip("not an exact-SPD backend")
-        import pybullet as pb
-
+        from toolkit.dynamics.model import Data
         from toolkit.dynamics.spd import spd_torques
 
-        for name in ("humanoid", "snake36", "atlas"):
-            c, ch, io = make_world(name)
+        for name in self.exact_bodies:
+            w = self.make_world(name)
             try:
-                model = ch.model()
+                model = w.model
                 backend = self.make()
                 backend.bind(model)
-                from toolkit.dynamics.model import Data
-
                 data = Data(model)
                 rng = np.random.default_rng(0)
                 for _ in range(2):
                     q, qd = model.random_state(rng)
                     qt, _ = model.random_state(rng)
-                    tau = np.array(backend.torques(q, qd, qt, ch.kp, ch.kd, DT))
-                    ref = spd_torques(model, data, q, qd, qt, ch.kp, ch.kd, DT, method="df")
+                    tau = np.array(backend.torques(q, qd, qt, w.kp, w.kd, DT))
+                    ref = spd_torques(model, data, q, qd, qt, w.kp, w.kd, DT, method="df")
                     assert np.abs(tau - ref).max() <= 1e-8 * np.abs(ref).max(), name
             finally:
-                pb.disconnect(c)
+                w.close()
 
     def test_unbound_backend_says_so(self):
         backend = self.make()

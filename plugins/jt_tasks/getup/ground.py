@@ -13,10 +13,10 @@ CLEARANCE = 0.005  #: m between the lowest point of a start pose and the ground 
 
 @functools.lru_cache(maxsize=1)
 def _kinematic_body() -> Any:
-    from toolkit.motion.kinematics import KinematicBody
+    from toolkit.motion.kinematics import kinematic_body
     from toolkit.motion.skeletons import HUMANOID
 
-    return KinematicBody(HUMANOID)
+    return kinematic_body(HUMANOID)
 
 
 def lowest_point(q: np.ndarray) -> float:

@@ -8,7 +8,7 @@ the DeepMimic clip, as the jump tasks do) and answers what the run-up environmen
 * the reference state ``(q, qd)`` at any clip time (``jt_tasks.takeoff.state.reference_state``: slerp pose and
   central-difference velocities, the root shifted by the clip's cycle offset on every loop);
 * forward kinematics of a state (link centres of mass, whole-body CoM) by a kinematic copy of
-  the humanoid (``toolkit.motion.kinematics.KinematicBody``, never stepped);
+  the humanoid (``toolkit.motion.kinematics.kinematic_body``, never stepped);
 * ``at(j)``: all of the above at clip time ``j / sim_hz``, memoised per process (the environment
   keeps its clip times on the simulation grid, so an episode's reference is computed once and
   shared by every environment of a rollout worker).
@@ -66,7 +66,7 @@ class RunReference:
     def __init__(self, clip_name: str = "run", foot: str = "right", contact_tol: float = 0.06,
                  foot_clearance: float = 0.002, sim_hz: float = 600.0) -> None:
         from toolkit.motion import load_clip
-        from toolkit.motion.kinematics import KinematicBody
+        from toolkit.motion.kinematics import kinematic_body
         from toolkit.motion.skeletons import motions_dir
 
         path = clip_name if os.path.sep in clip_name else os.path.join(motions_dir(), f"humanoid3d_{clip_name}.txt")
@@ -79,7 +79,7 @@ class RunReference:
         self.foot = foot
         self.period = float(self.clip.duration)
         self.t_mid, _ = support_phase_time(self.clip, foot, contact_tol)
-        self.body = KinematicBody(self.skeleton)
+        self.body = kinematic_body(self.skeleton)
         self.masses = self.body.masses
         self.ground_offset = 0.0
         q, _ = self.state(self.t_mid)

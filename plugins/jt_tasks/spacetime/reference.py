@@ -141,7 +141,7 @@ class SpacetimeReference:
     def __init__(self, clip: str = "run", heading_axis: str = "x", loop: Optional[bool] = None,
                  cycle_turn: bool = True) -> None:
         from toolkit.errors import JtError
-        from toolkit.motion.kinematics import KinematicBody, clip_velocities, forward_kinematics
+        from toolkit.motion.kinematics import clip_velocities, forward_kinematics, kinematic_body
 
         if heading_axis not in HEADING_AXES:
             raise JtError(f"task.heading_axis={heading_axis!r}: x or z")
@@ -157,7 +157,7 @@ class SpacetimeReference:
         vel = clip_velocities(c)
         self._vel = np.concatenate([vel.root_lin, vel.root_ang, vel.joints], axis=1)
         kin = forward_kinematics(c.skeleton, c.root_pos, c.root_rot, c.joints)
-        body = KinematicBody(c.skeleton)
+        body = kinematic_body(c.skeleton)
         try:
             self.masses = np.asarray(body.masses, dtype=float)
             self.lowest = np.array([body.lowest_point(np.concatenate([c.root_pos[i], c.root_rot[i], c.joints[i]]))

@@ -209,26 +209,6 @@ def spd_solver(spd: Any) -> Any:
     return backend
 
 
-def spd_backend(spd: Any, client: int, body: int) -> tuple[Any, Any]:
-    """A bound jt SPD backend for a raw PyBullet body (tests checking against PyBullet's M and C).
-
-    Args:
-        spd: the ``spd`` group (see ``spd_solver``), or None for maba.
-        client: PyBullet client id.
-        body: body id.
-
-    Returns:
-        ``(backend, model)``: the backend bound to ``Model.from_bullet(client, body)`` (fixed base,
-        then the three root joints and the 16 hinges in PyBullet joint order), and that model.
-    """
-    from toolkit.dynamics.model import Model
-
-    backend = spd_solver(spd)
-    model = Model.from_bullet(client, body)
-    backend.bind(model)
-    return backend, model
-
-
 class _Episode:
     """The simulation loop of one jump and what it measures."""
 

@@ -163,7 +163,8 @@ def test_same_inputs_give_identical_states():
 
 
 def test_render_shows_the_character():
-    from toolkit.render import Camera, render_frame
+    from jt_bullet.render import render_frame
+    from toolkit.render import Camera
 
     s = make("humanoid")
     try:

@@ -5,17 +5,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from toolkit.testing.spd import DT, SPDBackendSuite, make_world
+from jt_bullet.testing import BulletSPDWorlds, make_world
+from toolkit.testing.spd import DT, SPDBackendSuite
 
 from jt_spd.bullet import BulletBackend
 
 
-class TestBulletBackend(SPDBackendSuite):
+class TestBulletBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = BulletBackend
     reference_exact = False
 
     def test_steps_itself_and_never_returns_torques(self, humanoid):
-        _, ch, io = humanoid
+        ch = humanoid.character
         b = BulletBackend(None)
         b.bind(ch)
         assert b.steps_itself is True
@@ -23,7 +24,7 @@ class TestBulletBackend(SPDBackendSuite):
             b.torques(ch.q_init, np.zeros(ch.n_dof), ch.q_init, ch.kp, ch.kd, DT)
 
     def test_bind_rejects_a_bare_model(self, humanoid):
-        _, ch, _ = humanoid
+        ch = humanoid.character
         with pytest.raises(TypeError, match="BulletBody or a Character"):
             BulletBackend(None).bind(ch.model())
 

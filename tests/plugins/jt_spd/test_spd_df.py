@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from jt_bullet.testing import BulletSPDWorlds
 from toolkit.testing.spd import SPDBackendSuite
 
 from jt_spd.df import DenseBackend
 
 
-class TestDenseBackend(SPDBackendSuite):
+class TestDenseBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = DenseBackend

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from jt_bullet.testing import BulletSPDWorlds
 from toolkit.testing.spd import SPDBackendSuite
 
 from jt_spd.maba import MabaBackend
 
 
-class TestMabaBackend(SPDBackendSuite):
+class TestMabaBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = MabaBackend

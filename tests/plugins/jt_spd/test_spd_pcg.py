@@ -2,18 +2,20 @@
 
 from __future__ import annotations
 
+from jt_bullet.testing import BulletSPDWorlds
 from toolkit.testing.spd import SPDBackendSuite
 
 from jt_spd.pcg import PCGBackend
 
 
-class TestPCGBackend(SPDBackendSuite):
+class TestPCGBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = PCGBackend
 
     def test_tolerance_from_config_sets_the_work_done(self):
         import numpy as np
         import pybullet as pb
-        from toolkit.testing.spd import DT, make_world
+        from jt_bullet.testing import make_world
+        from toolkit.testing.spd import DT
 
         c, ch, _ = make_world("snake36")
         try:

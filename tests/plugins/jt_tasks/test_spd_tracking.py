@@ -60,7 +60,7 @@ def test_laikago_mocap_is_turned_into_the_y_up_world():
     import pybullet as pb
 
     from jt_tasks.spd_tracking.motions import make_reference
-    from toolkit.dynamics.bullet_io import BulletBody
+    from jt_bullet.body import BulletBody
 
     ch = loaded("laikago")
     try:

@@ -13,7 +13,8 @@ G = 9.8
 def _load(urdf_text: str, tmp_path, fixed: bool = True):
     import pybullet as pb
 
-    from toolkit.dynamics.model import Data, Model
+    from jt_bullet.model import model_from_bullet
+    from toolkit.dynamics.model import Data
 
     path = tmp_path / "body.urdf"
     path.write_text(urdf_text)
@@ -21,7 +22,7 @@ def _load(urdf_text: str, tmp_path, fixed: bool = True):
     pb.setGravity(0, -G, 0, physicsClientId=c)
     b = pb.loadURDF(str(path), [0, 0, 0], useFixedBase=fixed, physicsClientId=c,
                     flags=pb.URDF_USE_INERTIA_FROM_FILE)
-    m = Model.from_bullet(c, b, floating=not fixed)
+    m = model_from_bullet(c, b, floating=not fixed)
     return c, m, Data(m)
 
 

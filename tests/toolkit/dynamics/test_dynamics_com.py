@@ -14,7 +14,7 @@ from dynamics_worlds import SIMULABLE, state_in_limits
 def test_com_equals_pybullet(worlds, name, fixed):
     import pybullet as pb
 
-    from toolkit.dynamics.bullet_io import BulletBody
+    from jt_bullet.body import BulletBody
     from toolkit.dynamics.com import CenterOfMass
 
     w = worlds(name, fixed)

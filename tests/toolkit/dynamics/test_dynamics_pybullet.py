@@ -18,7 +18,7 @@ def test_one_step_of_pybullet_matches_aba(worlds, name, fixed):
     import pybullet as pb
 
     from toolkit.dynamics.aba import aba
-    from toolkit.dynamics.bullet_io import BulletBody
+    from jt_bullet.body import BulletBody
 
     w = worlds(name, fixed)
     io = BulletBody(w.client, w.character.body_id, w.model)
@@ -98,7 +98,7 @@ def test_snake_matches_pybullet_stable_pd_exactly(worlds):
     the spherical-joint SPD terms (predicted pose, log map) and the floating base."""
     import pybullet as pb
 
-    from toolkit.dynamics.bullet_io import BulletBody
+    from jt_bullet.body import BulletBody
     from toolkit.dynamics.maba import maba
 
     w = worlds("snake36", False)
@@ -122,7 +122,7 @@ def test_snake_matches_pybullet_stable_pd_exactly(worlds):
 def test_snake195_exceeds_pybullet_api():
     """PyBullet's shared-memory API carries at most 128 position coordinates; BulletBody says so
     rather than reading garbage."""
-    from toolkit.dynamics.bullet_io import PYBULLET_MAX_Q, BulletBody
+    from jt_bullet.body import PYBULLET_MAX_Q, BulletBody
 
     class Fake:
         n_q, name = 259, "snake195"
@@ -177,8 +177,9 @@ def test_rotated_frames_and_inertias_match_pybullet(tmp_path, fixed):
     import pybullet as pb
 
     from toolkit.dynamics.aba import aba
-    from toolkit.dynamics.bullet_io import BulletBody
-    from toolkit.dynamics.model import Data, Model
+    from jt_bullet.body import BulletBody
+    from jt_bullet.model import model_from_bullet
+    from toolkit.dynamics.model import Data
 
     path = tmp_path / "tilted.urdf"
     path.write_text(_tilted_urdf())
@@ -199,7 +200,7 @@ def test_rotated_frames_and_inertias_match_pybullet(tmp_path, fixed):
             else:
                 pb.setJointMotorControl2(b, j, pb.VELOCITY_CONTROL, force=0, physicsClientId=c)
         pb.changeDynamics(b, -1, linearDamping=0, angularDamping=0, physicsClientId=c)
-        m = Model.from_bullet(c, b, floating=not fixed)
+        m = model_from_bullet(c, b, floating=not fixed)
         d = Data(m)
         io = BulletBody(c, b, m)
         rng = np.random.default_rng(1)

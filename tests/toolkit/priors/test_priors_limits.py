@@ -17,6 +17,30 @@ def test_limits_come_from_the_urdf():
     assert np.allclose(low[sl["chest"]], -np.pi) and np.allclose(high[sl["right_hip"]], np.pi)
 
 
+def test_urdf_limits_are_what_pybullet_reads():
+    """The limits read from the URDF file equal PyBullet's ``getJointInfo`` (the reference) on
+    every skeleton, joint by joint (unlimited: lower >= upper there, +-pi here)."""
+    import pybullet as pb
+
+    from toolkit.motion.skeletons import SKELETONS, data_dir
+
+    for sk in SKELETONS.values():
+        low, high = joint_limits(sk)
+        c = pb.connect(pb.DIRECT)
+        try:
+            pb.setAdditionalSearchPath(data_dir(), physicsClientId=c)
+            body = pb.loadURDF(sk.urdf, globalScaling=sk.scale, flags=pb.URDF_MAINTAIN_LINK_ORDER,
+                               physicsClientId=c)
+            for j, s in zip(sk.joints, sk.dof_slices.values()):
+                if j.kind == "spherical":
+                    continue
+                lo, hi = pb.getJointInfo(body, j.bullet_index, physicsClientId=c)[8:10]
+                want = (lo, hi) if lo < hi else (-np.pi, np.pi)
+                assert (low[s][0], high[s][0]) == want, (sk.name, j.name)
+        finally:
+            pb.disconnect(c)
+
+
 def test_limit_targets_keeps_rotations_and_clips_angles():
     rng = np.random.default_rng(0)
     dofs = rng.uniform(-5.0, 5.0, (50, 28))

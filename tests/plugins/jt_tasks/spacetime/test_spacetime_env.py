@@ -179,10 +179,10 @@ def test_a_start_is_the_clips_own_pose_lifted_only_when_it_penetrates(clip):
     """Over 20 start phases: the start's lowest point is within 1 cm of the clip's own at that
     pose (no global lift), never below the ground, and in the run's flight phase it is airborne;
     the median clearance is ≤ 2 cm (issue: 7.0 cm on run, 7.9 on roll with the global lift)."""
-    from toolkit.motion.kinematics import KinematicBody
+    from toolkit.motion.kinematics import kinematic_body
 
     e = make_env(seed=0, clip=clip)
-    body = KinematicBody(e.skeleton)
+    body = kinematic_body(e.skeleton)
     lows = []
     try:
         for k in range(20):

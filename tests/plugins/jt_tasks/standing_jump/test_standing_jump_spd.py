@@ -8,7 +8,8 @@ from omegaconf import OmegaConf
 
 from jt_tasks.standing_jump import StandingJumpTask
 from jt_tasks.standing_jump.model import build_body
-from jt_tasks.standing_jump.simulate import SimSettings, open_world, simulate, spd_backend
+from jt_bullet.model import model_from_bullet
+from jt_tasks.standing_jump.simulate import SimSettings, open_world, simulate, spd_solver
 from toolkit.errors import JtError
 
 DT = 1.0 / 600.0
@@ -33,6 +34,15 @@ def reference_spd(p, cid, robot, q, qd, qt, qdt, kp, kd, dt):
     pos = q + qd * dt - qt
     qdd = np.linalg.solve(M + np.diag(kd * dt), -C - kp * pos - kd * (qd - qdt))
     return -kp * pos - kd * (qd + qdd * dt - qdt)
+
+
+def spd_backend(spd, cid, robot):
+    """The registry backend of ``spd`` bound to the robot's model (fixed base, then the three root
+    joints and the 16 hinges in PyBullet joint order), and that model."""
+    backend = spd_solver(spd)
+    model = model_from_bullet(cid, robot)
+    backend.bind(model)
+    return backend, model
 
 
 def random_case(rng, n):
@@ -76,7 +86,7 @@ def test_reduced_gravity_reaches_the_spd_model(world):
 def test_bullet_spd_is_refused(world):
     _, cid, robot, _ = world
     with pytest.raises(JtError, match="maba, df, sf or pcg"):
-        spd_backend({"name": "bullet"}, cid, robot)
+        spd_solver({"name": "bullet"})
 
 
 def test_task_reads_the_spd_group_and_falls_back_to_maba():

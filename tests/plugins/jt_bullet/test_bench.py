@@ -1,4 +1,4 @@
-"""Benchmark functions run end to end on a tiny budget (speed is measured by them, not here)."""
+"""``jt_bullet.bench`` end to end on a tiny budget (speed is measured by it, not here)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 
 def test_time_spd_rows_and_summary():
-    from toolkit.dynamics.bench import BACKENDS, format_table, summarize, time_spd
+    from jt_bullet.bench import BACKENDS, format_table, summarize, time_spd
 
     rows = time_spd(["humanoid", "snake195"], backends=BACKENDS, n_samples=3, seed=0)
     assert len(rows) == 2 * len(BACKENDS)
@@ -21,3 +21,9 @@ def test_time_spd_rows_and_summary():
     s = summarize(rows)
     assert s["df_over_maba_solve_195"] > 0 and math.isnan(s["maba_solve_growth_36_to_195"])
     assert "humanoid" in format_table(rows)
+
+
+def test_check_agreement_reports_tiny_differences():
+    from jt_bullet.bench import check_agreement
+
+    assert check_agreement(["humanoid", "snake36"], n_states=2, seed=1) < 1e-8

@@ -28,7 +28,7 @@ class BulletBody:
     Args:
         client: PyBullet physics client id.
         body_id: body unique id.
-        model: its ``Model`` (``Model.from_bullet``).
+        model: its ``Model`` (``jt_bullet.model.model_from_bullet``).
 
     Raises:
         ValueError: if the body has more position coordinates than PyBullet's API can carry.

@@ -8,9 +8,9 @@
 * ``check_agreement`` returns the largest relative torque difference between the four solvers.
 * ``summarize`` turns the rows into the ratios the targets in ``docs/maba.md`` are stated in.
 
-Characters come from ``loader(name, client)``; by default the ``bullet`` simulator plugin's
-``load_character`` found through the registry (``toolkit`` never imports a plugin module); pass
-``loader`` to use another source.
+Characters come from ``loader(name, client)``; by default ``BulletSimulator.load_character``; pass
+``loader`` to use another source. ``jt bench spd`` reaches this module through the registered
+simulator (``BulletSimulator.spd_bench``): the toolkit imports no plugin.
 """
 
 from __future__ import annotations
@@ -21,7 +21,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from toolkit.dynamics.bullet_io import PYBULLET_MAX_Q, BulletBody
+from jt_bullet.body import PYBULLET_MAX_Q, BulletBody
+from jt_bullet.model import model_from_bullet
 from toolkit.dynamics.model import Data, Model
 from toolkit.dynamics.spd import METHODS, spd_solve
 
@@ -30,10 +31,10 @@ SOLVE_BLOCK = 10  #: consecutive solves per backend before switching (keeps cach
 
 
 def default_loader() -> Callable[[str, int], Any]:
-    """``load_character`` of the registered ``bullet`` simulator (``jt.simulators``)."""
-    from toolkit import plugins
+    """``BulletSimulator.load_character``: jt's characters with their config's gains."""
+    from jt_bullet.simulator import BulletSimulator
 
-    return plugins.load("sim", "bullet").load_character
+    return BulletSimulator.load_character
 
 
 def _world(dt: float) -> int:
@@ -94,7 +95,7 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
         One row per (model, backend): ``model``, ``dof``, ``depth``, ``backend``,
         ``solve_us_median`` (NaN for ``bullet``, whose solve happens inside PyBullet's step) and
         ``step_us_median`` (NaN where PyBullet cannot drive the body: more than 128 position
-        coordinates, see ``toolkit.dynamics.bullet_io``).
+        coordinates, see ``jt_bullet.body``).
     """
     import pybullet as pb
 
@@ -104,7 +105,7 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
         rng = np.random.default_rng(seed)
         c = _world(dt)
         ch = load(name, c)
-        model = Model.from_bullet(c, ch.body_id, name=name, floating=not ch.fixed_base)
+        model = model_from_bullet(c, ch.body_id, name=name, floating=not ch.fixed_base)
         data = Data(model)
         kp, kd = np.asarray(ch.kp, float), np.asarray(ch.kd, float)
         ours = [b for b in backends if b in METHODS]
@@ -179,7 +180,7 @@ def check_agreement(models: Sequence[str], n_states: int = 20, seed: int = 0,
         rng = np.random.default_rng(seed)
         c = pb.connect(pb.DIRECT)
         ch = load(name, c)
-        model = Model.from_bullet(c, ch.body_id, name=name, floating=not ch.fixed_base)
+        model = model_from_bullet(c, ch.body_id, name=name, floating=not ch.fixed_base)
         pb.disconnect(c)
         data = Data(model)
         kp, kd = np.asarray(ch.kp, float), np.asarray(ch.kd, float)
