@@ -312,7 +312,7 @@ def run_bench(task: str, overrides: list[str], rates: list[float], control_steps
 class _EnvFn:
     """Picklable ``env_fn(seed)`` for the rollout workers, built as training builds its own: a policy
     task's env spec is made once here and pickled to the workers with its env class (what
-    ``jt_tasks.policy.train.EnvFactory`` does), so a worker's memory is what it is in a training
+    ``toolkit.policy.train.EnvFactory`` does), so a worker's memory is what it is in a training
     run; any other task is composed in the worker (plugins through the registry)."""
 
     def __init__(self, task: str, overrides: list[str], built: Any = None) -> None:

@@ -12,7 +12,7 @@ from typing import Optional
 from jt_tasks.getup.curves import REFERENCE
 from jt_tasks.getup.styles import STYLES as AUTHORED_STYLES
 from jt_tasks.getup.terrain import REGIONS, TerrainSpec
-from jt_tasks.policy.task import PolicyConfig
+from toolkit.policy.task import PolicyConfig
 
 
 @dataclasses.dataclass

@@ -37,8 +37,8 @@ from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.ground import lift_to_ground
 from jt_tasks.getup.initial import clip_pose, clip_state_at, perturb_joints, pick_curve
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
-from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.spec import default_of
+from toolkit.policy.env import CharacterEnv
+from toolkit.policy.spec import default_of
 from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
 
@@ -50,7 +50,7 @@ LOOKAHEAD = np.array([0.0, 0.1, 0.2, 0.3])  #: s, curve targets in the state (00
 class GetupSpec:
     """Everything a get-up environment needs, as plain picklable data. A field named as one of
     ``GetupConfig``'s has its default from there (``GetupConfig`` documents it); the rest are
-    the task's resolved values (``jt_tasks.policy.spec``)."""
+    the task's resolved values (``toolkit.policy.spec``)."""
 
     curves: list = dataclasses.field(default_factory=list)  # FeatureCurve.to_dict() each
     fallen: list = dataclasses.field(default_factory=list)  # initial.fallen_states() entries

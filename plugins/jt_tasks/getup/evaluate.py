@@ -34,7 +34,7 @@ COLUMNS = ("success", "got_up", "time_to_rise", "task_return_rate", "early")  #:
 def evaluate_regions(task: Any, spec: Any, model: Any) -> dict[str, dict[str, np.ndarray]]:
     """One deterministic get-up per evaluation drop of each region: ``{region: {column: (n,)}}``
     plus ``x``, ``z``, ``style`` (0 prone, 1 supine) and ``curve`` per episode."""
-    from jt_tasks.policy.train import rollout
+    from toolkit.policy.train import rollout
 
     p = task.params
     out: dict[str, dict[str, np.ndarray]] = {}

@@ -127,7 +127,7 @@ def fallen_states(sim_groups: dict, n: int, seed: int, styles: Sequence[str] = S
     A drop the simulator flags as failed (exploded) is never accepted: it is drawn again, up to
     ``3 * max_tries`` times, then ``RuntimeError``.
     """
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
 
     if n <= 0:
         return []

@@ -31,7 +31,7 @@ def open_loop_clip(clip: str, sim_groups: dict, t_stand: float = 3.0, mirrored: 
     from jt_tasks.getup import features as F
     from jt_tasks.getup.curves import load_getup_clip
     from jt_tasks.getup.initial import clip_pose
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
     from jt_tasks.takeoff.state import reference_state
 
     c = load_getup_clip(clip, mirrored)

@@ -24,8 +24,8 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.getup.config import GetupConfig
-from jt_tasks.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
-from jt_tasks.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
+from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
+from toolkit.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
 #: per-iteration means over episodes from the ground (clip first poses and rag-doll states; not
@@ -126,7 +126,7 @@ class GetupTask(PolicyTask):
 
     def env_spec(self, point: dict[str, float]) -> Any:
         from jt_tasks.getup.env import GetupSpec
-        from jt_tasks.policy.spec import spec_of
+        from toolkit.policy.spec import spec_of
 
         p = self.params
         sim, action = self.character_groups()
@@ -145,7 +145,7 @@ class GetupTask(PolicyTask):
         import functools
 
         from jt_tasks.getup.stage1 import ClipStartTraining
-        from jt_tasks.policy.train import agent_config
+        from toolkit.policy.train import agent_config
         from toolkit import plugins
 
         total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
@@ -197,7 +197,7 @@ class GetupTask(PolicyTask):
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Hooks, workdir: Path) -> Evaluation:
-        from jt_tasks.policy.train import return_curve, rollout
+        from toolkit.policy.train import return_curve, rollout
         from toolkit.rl.checkpoint import load_policy
 
         from jt_tasks.getup import evaluate as E

@@ -7,7 +7,7 @@ import dataclasses
 import os
 from typing import Optional
 
-from jt_tasks.policy.task import PolicyConfig
+from toolkit.policy.task import PolicyConfig
 
 FOSBURY = {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.40}  # 000 Table 3
 

@@ -39,8 +39,8 @@ import numpy as np
 from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
 from jt_tasks.jumping.config import JumpConfig as _C
-from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.spec import default_of
+from toolkit.policy.env import CharacterEnv
+from toolkit.policy.spec import default_of
 from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
 from toolkit.interfaces.simulator import ContactRule, Watch
 
@@ -51,7 +51,7 @@ HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index
 class EnvSpec:
     """Everything an environment needs, as plain picklable data. A field named as one of
     ``JumpConfig``'s has its default from there (documented there); the rest are the task's
-    resolved values (``jt_tasks.policy.spec``)."""
+    resolved values (``toolkit.policy.spec``)."""
 
     kind: str = "highjump"  # highjump | obstacle
     features: dict = dataclasses.field(default_factory=dict)  # take-off features by name

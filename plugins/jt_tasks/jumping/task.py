@@ -24,7 +24,7 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.jumping.config import JumpConfig, LongJumpConfig, ObstacleConfig
-from jt_tasks.policy.task import PolicyTask, require_humanoid_and_prior
+from toolkit.policy.task import PolicyTask, require_humanoid_and_prior
 
 
 def require_own_control_rate(cfg: Any, task: str) -> None:
@@ -155,7 +155,7 @@ class JumpTask(PolicyTask):
         """The ``EnvSpec`` for take-off features ``point`` (missing ones: the defaults)."""
         from jt_tasks.jumping.env import EnvSpec
         from jt_tasks.jumping.scene import SuiteSpec
-        from jt_tasks.policy.spec import spec_of
+        from toolkit.policy.spec import spec_of
 
         p, cfg = self.params, self.cfg
         feats = {**(p.takeoff or {}), **{k: float(v) for k, v in point.items()},
@@ -185,7 +185,7 @@ class JumpTask(PolicyTask):
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Any:
         from jt_tasks.jumping.train import curriculum_hooks
-        from jt_tasks.policy.train import agent_config
+        from toolkit.policy.train import agent_config
 
         init = self.stage2_init()
         total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
@@ -228,8 +228,8 @@ class JumpTask(PolicyTask):
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
         from jt_tasks.jumping.train import jump_curves
-        from jt_tasks.policy.history import base_metrics, finite
-        from jt_tasks.policy.train import return_curve
+        from toolkit.policy.history import base_metrics, finite
+        from toolkit.policy.train import return_curve
 
         res, init = trained.result, self.stage2_init()
         trained_z = float(hooks.state["cur"].env_attrs().get(hooks.state["z_attr"], math.nan))  # the curriculum's z

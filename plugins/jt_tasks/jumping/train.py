@@ -15,7 +15,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from jt_tasks.policy.task import Hooks
+from toolkit.policy.task import Hooks
 
 
 def curriculum_hooks(spec: Any, cur: Any, total_samples: int, progress: Optional[Any],
@@ -70,7 +70,7 @@ def after_training(hooks: Hooks, result: Any) -> None:
 
 def jump_curves(hooks: Hooks, result: Any) -> dict[str, list]:
     """``z`` (bar height / obstacle width), success rate and (Stage 2) novelty against samples."""
-    from jt_tasks.policy.train import TIMES
+    from toolkit.policy.train import TIMES
 
     z_attr, z_hist = hooks.state["z_attr"], hooks.state["z_hist"]
     times = [float(t) for t in np.asarray(result.extra.get(TIMES, np.zeros(0)), dtype=np.float64).ravel()]

@@ -37,8 +37,8 @@ import numpy as np
 from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat
 from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
-from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.spec import default_of
+from toolkit.policy.env import CharacterEnv
+from toolkit.policy.spec import default_of
 from jt_tasks.runup.task import RunupConfig as _C
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
@@ -48,7 +48,7 @@ from toolkit.motion import rotations as rot
 class RunupSpec:
     """Everything a run-up environment needs, as plain picklable data. A field named as one of
     ``RunupConfig``'s has its default from there (documented there); ``target`` is the task's
-    resolved take-off features (``jt_tasks.policy.spec``)."""
+    resolved take-off features (``toolkit.policy.spec``)."""
 
     kind: str = default_of(_C, "kind")
     target: dict = dataclasses.field(default_factory=dict)  # resolved: desired take-off features by name

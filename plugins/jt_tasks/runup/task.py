@@ -23,8 +23,8 @@ from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from jt_tasks.policy.history import IterationHistory, base_metrics, finite, numbers
-from jt_tasks.policy.task import Hooks, PolicyConfig, PolicyTask, require_humanoid_and_prior
+from toolkit.policy.history import IterationHistory, base_metrics, finite, numbers
+from toolkit.policy.task import Hooks, PolicyConfig, PolicyTask, require_humanoid_and_prior
 
 #: per-iteration means of the finished episodes (``extra["goal_history"]``), and their curves' names
 HISTORY = ("r_goal", "r_imitation_mean", "took_off")
@@ -117,7 +117,7 @@ class RunupTask(PolicyTask):
 
     def env_spec(self, point: dict[str, float]) -> Any:
         """The ``RunupSpec`` for target features ``point`` (missing ones: the defaults)."""
-        from jt_tasks.policy.spec import spec_of
+        from toolkit.policy.spec import spec_of
         from jt_tasks.runup.env import RunupSpec
 
         p = self.params
@@ -131,7 +131,7 @@ class RunupTask(PolicyTask):
     def training(self, spec: Any, ctx: EvalContext) -> Any:
         """The per-iteration means of finished episodes' ``r_goal``, imitation reward and take-off
         rate (``extra["goal_history"]``)."""
-        from jt_tasks.policy.train import agent_config
+        from toolkit.policy.train import agent_config
 
         extra: dict[str, Any] = {}
         total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
@@ -161,7 +161,7 @@ class RunupTask(PolicyTask):
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
-        from jt_tasks.policy.train import return_curve
+        from toolkit.policy.train import return_curve
         from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
 
         info = ro["info"]

@@ -114,7 +114,7 @@ def reference_frames(env: Any, times: np.ndarray, width: int, height: int) -> li
     (``SpacetimeEnv``). About 6 ms a frame at 120 x 90 on 2 shared cores (4 s for a 20 s rollout)."""
     from toolkit.render import Camera
 
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
 
     sim = load_simulator(env.spec_.sim)
     camera = Camera(**env.CAMERA) if env.CAMERA else None
@@ -154,7 +154,7 @@ def reference_bodies(env: Any, times: np.ndarray) -> list:
     """The reference of ``env`` (still open) posed at clip times ``env.t0 + times`` in a second
     simulator (kinematically, as ``reference_frames``): ``[(link CoMs, joint origins), ...]`` for
     ``style_measures``."""
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
 
     sim = load_simulator(env.spec_.sim)
     out = []

@@ -1,6 +1,6 @@
 """``task=spacetime``'s parameters: every ``task.*`` default with its source (``002``, Ma et al.
 2021, and the authors' code where the paper is silent). ``SpacetimeSpec`` takes the defaults of
-the fields it shares with this from here (``jt_tasks.policy.spec``).
+the fields it shares with this from here (``toolkit.policy.spec``).
 """
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, ClassVar, Optional
 
-from jt_tasks.policy.task import PolicyConfig
+from toolkit.policy.task import PolicyConfig
 
 
 @dataclasses.dataclass

@@ -43,8 +43,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.spec import default_of
+from toolkit.policy.env import CharacterEnv
+from toolkit.policy.spec import default_of
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig as _C
 from jt_tasks.spacetime import bounds as bd

@@ -23,7 +23,7 @@ def replay(config: Any, checkpoint: str) -> tuple[Any, dict[str, Any]]:
     """The final evaluation of a run with ``config`` (its composed config) and policy
     ``checkpoint`` (``ppo.h5``), replayed: the env (still open, holding ``eval_bodies``) and the
     rollout (``tr.rollout``'s dict)."""
-    from jt_tasks.policy import train as tr
+    from toolkit.policy import train as tr
     from toolkit import plugins
     from toolkit.rl.checkpoint import load_policy
 

@@ -25,8 +25,8 @@ import numpy as np
 from toolkit.config import group_of
 from toolkit.interfaces.task import Evaluation
 
-from jt_tasks.policy.history import base_metrics, finite, numbers
-from jt_tasks.policy.task import Hooks, PolicyTask
+from toolkit.policy.history import base_metrics, finite, numbers
+from toolkit.policy.task import Hooks, PolicyTask
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig
 
@@ -44,7 +44,7 @@ class SpacetimeTask(PolicyTask):
     @classmethod
     def check_run(cls, cfg: Any) -> None:
         """The humanoid: its bounds, channels and reference clips are the DeepMimic humanoid's."""
-        from jt_tasks.policy.task import require_humanoid_and_prior
+        from toolkit.policy.task import require_humanoid_and_prior
 
         require_humanoid_and_prior(cfg, "spacetime", "its bounds and reference clips are the DeepMimic humanoid's")
 
@@ -64,7 +64,7 @@ class SpacetimeTask(PolicyTask):
         axis, bound widths and allowed contacts resolved, the simulator and action groups."""
         from toolkit.motion.skeletons import HUMANOID
 
-        from jt_tasks.policy.spec import spec_of
+        from toolkit.policy.spec import spec_of
         from jt_tasks.spacetime import bounds as bd
         from jt_tasks.spacetime.env import SpacetimeSpec
         from jt_tasks.spacetime.reference import resolve_clip
@@ -88,7 +88,7 @@ class SpacetimeTask(PolicyTask):
         Table 1's evaluation every ``eval_every`` iterations; their state rides in ``extra``."""
         import functools
 
-        from jt_tasks.policy.train import agent_config
+        from toolkit.policy.train import agent_config
         from jt_tasks.spacetime.sampling import StartSampler
         from jt_tasks.spacetime.training import SpacetimeTraining
 
@@ -127,7 +127,7 @@ class SpacetimeTask(PolicyTask):
         return data, attrs
 
     def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
-        from jt_tasks.policy.train import last_finite, return_curve, samples_axis
+        from toolkit.policy.train import last_finite, return_curve, samples_axis
 
         res, info = trained.result, ro["info"]
         steps = int(ro["steps"])

@@ -7,7 +7,7 @@ from toolkit.testing.simulator import SimulatorContract
 
 class TestBulletSimulator(SimulatorContract):
     def make(self, **sim):
-        from jt_tasks.policy.env import load_simulator
+        from toolkit.policy.env import load_simulator
 
         return load_simulator({"sim": {"name": "bullet", **sim}, "spd": {"name": "df"},
                                "character": {"name": "humanoid"}})
@@ -17,7 +17,7 @@ class TestBulletSimulatorPythonLoop(SimulatorContract):
     """The same contract on the reference Python substep loop (``sim.loop=python``)."""
 
     def make(self, **sim):
-        from jt_tasks.policy.env import load_simulator
+        from toolkit.policy.env import load_simulator
 
         return load_simulator({"sim": {"name": "bullet", "loop": "python", **sim}, "spd": {"name": "df"},
                                "character": {"name": "humanoid"}})

@@ -108,7 +108,7 @@ def test_bench_rollout_with_training_through_the_cli(tmp_path):
 
 def test_collection_workers_get_the_spec_built_once_as_training_does():
     """The bench's ``env_fn`` carries the policy task's env class and the spec made by the driver
-    (what ``jt_tasks.policy.train.EnvFactory`` gives a training run's workers): a worker does not
+    (what ``toolkit.policy.train.EnvFactory`` gives a training run's workers): a worker does not
     compose the task or build the spec again, so its memory is a training worker's."""
     import pickle
 

@@ -12,7 +12,7 @@ def sim_groups() -> dict:
 def standing_sim() -> Any:
     """A bullet simulator holding the last (standing) frame of getup_facedown on flat ground."""
     from jt_tasks.getup.initial import clip_pose
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
 
     sim = load_simulator(sim_groups())
     q, qd = clip_pose("getup_facedown", False, frame=-1)

@@ -15,7 +15,7 @@ from toolkit.errors import JtError
 @pytest.fixture(scope="module")
 def world():
     """A bullet simulator holding the default terrain."""
-    from jt_tasks.policy.env import load_simulator
+    from toolkit.policy.env import load_simulator
 
     sim = load_simulator(sim_groups())
     spec = T.TerrainSpec()

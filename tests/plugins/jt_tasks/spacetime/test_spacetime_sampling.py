@@ -137,7 +137,7 @@ def test_ppo_reports_visits_with_targets_and_the_starts_follow_the_payload():
     from toolkit.rl import ppo
     from toolkit.rl.config import PPOConfig
 
-    from jt_tasks.policy.train import EnvFactory
+    from toolkit.policy.train import EnvFactory
     from jt_tasks.spacetime.env import SpacetimeEnv
 
     from spacetime_helpers import make_spec

@@ -26,7 +26,7 @@ def test_composes_with_its_groups_and_every_field_has_a_source():
     assert cfg.agent.gamma == 0.95
     import inspect
 
-    from jt_tasks.policy.task import PolicyConfig
+    from toolkit.policy.task import PolicyConfig
 
     text = inspect.getsource(SpacetimeConfig)
     inherited = {f.name for f in dataclasses.fields(PolicyConfig)} - set(SpacetimeConfig.__dict__.get("__annotations__", {}))

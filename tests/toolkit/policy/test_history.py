@@ -1,4 +1,4 @@
-"""The policy tasks' shared per-iteration history and metric plumbing (jt_tasks.policy.history)."""
+"""The policy tasks' shared per-iteration history and metric plumbing (toolkit.policy.history)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from jt_tasks.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
+from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
 
 
 def stats(*episodes: dict) -> SimpleNamespace:

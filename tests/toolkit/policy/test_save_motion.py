@@ -3,7 +3,7 @@
 import numpy as np
 from PIL import Image
 
-from jt_tasks.policy.train import save_motion
+from toolkit.policy.train import save_motion
 
 
 def test_filmstrip_and_a_gif_you_can_watch(tmp_path):

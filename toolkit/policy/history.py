@@ -43,14 +43,14 @@ def base_metrics(ro: Mapping[str, Any], trained: Any) -> dict[str, float]:
     """The metrics every policy task reports: the deterministic rollout's return and PPO's counters.
 
     Args:
-        ro: the rollout (``jt_tasks.policy.train.rollout``), its ``return``.
-        trained: ``jt_tasks.policy.train.Trained``.
+        ro: the rollout (``toolkit.policy.train.rollout``), its ``return``.
+        trained: ``toolkit.policy.train.Trained``.
 
     Returns:
         ``mean_return``, ``train_mean_return`` (the last finite training mean), ``samples``,
         ``iterations``, ``samples_per_s``, ``train_wall_s``.
     """
-    from jt_tasks.policy.train import last_finite
+    from toolkit.policy.train import last_finite
 
     res = trained.result
     return {"mean_return": float(ro["return"]),

@@ -1,4 +1,4 @@
-"""``jt_tasks.policy.spec``: an env's spec derived from its task's Config, one default per value."""
+"""``toolkit.policy.spec``: an env's spec derived from its task's Config, one default per value."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ class _Config:
 
 
 def test_spec_of_copies_shared_fields_and_takes_derived_ones():
-    from jt_tasks.policy.spec import default_of, spec_of
+    from toolkit.policy.spec import default_of, spec_of
 
     @dataclasses.dataclass
     class Spec:
@@ -38,7 +38,7 @@ def test_spec_of_copies_shared_fields_and_takes_derived_ones():
 def test_spacetime_spec_defaults_are_its_configs():
     """Every field SpacetimeSpec shares with SpacetimeConfig has the Config's default (a restated
     default that differs fails here)."""
-    from jt_tasks.policy.spec import shared_fields
+    from toolkit.policy.spec import shared_fields
     from jt_tasks.spacetime.config import SpacetimeConfig
     from jt_tasks.spacetime.env import SpacetimeSpec
 
@@ -55,7 +55,7 @@ def test_every_user_value_reaches_the_spacetime_spec():
     from toolkit import plugins
     from toolkit.config import compose
 
-    from jt_tasks.policy.spec import shared_fields
+    from toolkit.policy.spec import shared_fields
     from jt_tasks.spacetime.config import SpacetimeConfig
     from jt_tasks.spacetime.env import SpacetimeSpec
 
@@ -77,7 +77,7 @@ def test_getup_spec_defaults_are_its_configs():
     Config names the curves, the spec holds them; the spec's {} terrain is flat ground)."""
     from jt_tasks.getup.config import GetupConfig
     from jt_tasks.getup.env import GetupSpec
-    from jt_tasks.policy.spec import shared_fields
+    from toolkit.policy.spec import shared_fields
 
     shared = set(shared_fields(GetupSpec, GetupConfig)) - {"curves", "terrain"}
     assert {"t_stand", "natural_terms", "heightmap_spacing", "success_window"} <= shared
@@ -88,7 +88,7 @@ def test_getup_spec_defaults_are_its_configs():
 
 def test_runup_spec_defaults_are_its_configs():
     """The same for RunupSpec and RunupConfig; target is the task's resolved take-off features."""
-    from jt_tasks.policy.spec import shared_fields
+    from toolkit.policy.spec import shared_fields
     from jt_tasks.runup.env import RunupSpec
     from jt_tasks.runup.task import RunupConfig
 
@@ -104,7 +104,7 @@ def test_jump_env_spec_defaults_are_its_configs():
     Config); policy_features is the task's resolved Stage-2 list."""
     from jt_tasks.jumping.config import JumpConfig
     from jt_tasks.jumping.env import EnvSpec
-    from jt_tasks.policy.spec import shared_fields
+    from toolkit.policy.spec import shared_fields
 
     shared = set(shared_fields(EnvSpec, JumpConfig)) - {"policy_features"}
     assert {"clip", "foot", "omega_y", "v_y", "time_limit", "safe_margin", "check_every"} <= shared

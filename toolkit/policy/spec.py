@@ -4,7 +4,7 @@ A policy task's env runs in rollout workers from a plain, picklable ``*Spec`` da
 fields a spec shares by name with the task's ``Config`` are copied by ``spec_of`` — not by a hand
 copy per field — and a spec declares a shared field's default as the ``Config``'s
 (``default_of``), so a value the user sets in ``task.*`` reaches the env through one mechanism and
-a default cannot differ between the two (``tests/plugins/jt_tasks/policy/test_spec.py``).
+a default cannot differ between the two (``tests/toolkit/policy/test_spec.py``).
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ from typing import Any, Callable, ClassVar, Optional
 from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
-from jt_tasks.policy import train as tr
+from toolkit.policy import train as tr
 
 
 def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
@@ -154,7 +154,7 @@ class PolicyTask(Task):
 
     def measure(self, spec: Any, ro: dict, trained: tr.Trained, hooks: Hooks, workdir: Path) -> Evaluation:
         """The evaluation's metrics from the deterministic rollout and the training."""
-        from jt_tasks.policy.history import base_metrics
+        from toolkit.policy.history import base_metrics
 
         return Evaluation(metrics=base_metrics(ro, trained), history={"mean_return": tr.return_curve(trained)})
 

@@ -2,9 +2,9 @@
 
 import dataclasses
 import numpy as np
-from jt_tasks.policy.env import CharacterEnv
-from jt_tasks.policy.spec import default_of, spec_of
-from jt_tasks.policy.task import PolicyConfig, PolicyTask
+from toolkit.policy.env import CharacterEnv
+from toolkit.policy.spec import default_of, spec_of
+from toolkit.policy.task import PolicyConfig, PolicyTask
 from toolkit.interfaces import ContactRule, Watch
 
 @dataclasses.dataclass
