@@ -82,13 +82,14 @@ def _resume_config(run_id: str, overrides: list[str]):  # type: ignore[no-untype
     from toolkit.config import validate
     from toolkit.errors import JtError
     from toolkit.execution.lifecycle import saved_config
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import store_root
+    from toolkit.store.opening import open_store
 
     others = [o for o in overrides if not o.startswith(("resume=", "store="))]
     if others:
         raise JtError(f"resume= continues a run with its own config; drop: {' '.join(others)}")
     stores = [o.split("=", 1)[1] for o in overrides if o.startswith("store=")]
-    store = Store(store_root(stores[0] if stores else None), must_exist=True)
+    store = open_store(store_root(stores[0] if stores else None), must_exist=True)
     run = store.get_run(run_id)  # one clear line if the id is unknown
     path = saved_config(store, run_id, run)  # saved before the run existed: never missing after a kill
     if path is None and store.is_server:  # a server store, resumed on another machine

@@ -31,10 +31,10 @@ SOLVE_BLOCK = 10  #: consecutive solves per backend before switching (keeps cach
 
 
 def default_loader() -> Callable[[str, int], Any]:
-    """``BulletSimulator.load_character``: jt's characters with their config's gains."""
-    from jt_bullet.simulator import BulletSimulator
+    """``characters.load_configured``: jt's characters with their config's gains."""
+    from jt_bullet.characters import load_configured
 
-    return BulletSimulator.load_character
+    return load_configured
 
 
 def _world(dt: float) -> int:

@@ -261,3 +261,49 @@ def load(name: str, client: Any, **kw: Any) -> Character:
     except KeyError:
         raise ValueError(f"unknown character {name!r}; known: {sorted(LOADERS)}") from None
     return loader(client, **kw)
+
+
+def load_configured(name: Any, client: Any, **kw: Any) -> "Character":
+    """Load a character into ``client`` with a ``CharacterConfig``'s gain overrides applied.
+
+    For tools (``jt bench spd``) that need the built-in characters without a simulator.
+
+    Args:
+        name: a character name, or a ``character`` config node / ``CharacterConfig``.
+        client: PyBullet client id.
+        **kw: passed to the loader (``base_position``, ``self_collision`` ...).
+
+    Returns:
+        A ``jt_bullet.characters.Character`` (``kp``, ``kd``, ``torque_limit`` overridden).
+
+    Raises:
+        UnknownName: ``joint_kp`` / ``joint_kd`` / ``joint_torque_limit`` names a joint the
+        character has not (a one-line ``JtError``, also a ``KeyError``; it lists the
+        movable joints).
+    """
+    from jt_bullet import scene
+    from jt_bullet.config import CharacterConfig
+    from jt_bullet.queries import UnknownName
+
+    cc = CharacterConfig.from_node(name)
+    ch = load(cc.name, client, **kw)
+    if cc.kp is None and cc.kd is None and cc.torque_limit is None and not (
+            cc.joint_kp or cc.joint_kd or cc.joint_torque_limit):
+        return ch
+    base = 0 if ch.fixed_base else 6
+    for arr, value in ((ch.kp, cc.kp), (ch.kd, cc.kd), (ch.torque_limit, cc.torque_limit)):
+        if value is not None:
+            arr[base:] = float(value)
+    names = scene.joint_names(ch.client, ch.body_id)
+    slices, k = {}, base
+    for j, n in zip(ch.joint_indices, ch.joint_dofs):
+        slices[names[j]] = slice(k, k + n)
+        k += n
+    for arr, table in ((ch.kp, cc.joint_kp), (ch.kd, cc.joint_kd), (ch.torque_limit, cc.joint_torque_limit)):
+        for joint, value in table.items():
+            if joint not in slices:
+                raise UnknownName(f"character {cc.name!r} has no movable joint {joint!r}; "
+                                  f"joints: {', '.join(slices)}")
+            arr[slices[joint]] = float(value)
+    ch.gains_source += " (overridden by the character config)"
+    return ch

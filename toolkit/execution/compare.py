@@ -97,7 +97,8 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
     """Run every variant for ``seeds`` seeds and record the comparison."""
     from toolkit import plugins
     from toolkit.config import compose
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import store_root
+    from toolkit.store.opening import open_store
 
     if seeds < 1:
         raise JtError("--seeds must be at least 1")
@@ -122,7 +123,7 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
             ov = [*plain, *(f"{k}={v}" for k, v in chosen.items()), f"seed={first + s}"]
             cfg = compose(ov)  # check every cell before running any
             cells.append((values, ov, cfg))
-    store = Store(store_root(str(base.store)))
+    store = open_store(store_root(str(base.store)))
     task_cls = plugins.load("task", str(base.task.name))
     label = ", ".join(f"{k}={','.join(v)}" for k, v in grid)
     experiment = str(base.task.name)
@@ -192,7 +193,8 @@ def variant_label(p: dict[str, str], differing: Sequence[str]) -> str:
 def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareResult:
     """Compare finished runs: variants are the params that differ between them (seed excepted)."""
     from toolkit import plugins
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.opening import open_store
+    from toolkit.store.tracking import store_root
 
     store_path = None
     for o in overrides:
@@ -202,7 +204,7 @@ def compare_runs(run_ids: Sequence[str], overrides: Sequence[str]) -> CompareRes
             raise JtError(f"unexpected argument '{o}' with --runs; only store=PATH is accepted")
     if len(run_ids) < 2:
         raise JtError("--runs needs at least two run ids")
-    store = Store(store_root(store_path))
+    store = open_store(store_root(store_path))
     runs = [store.get_run(r) for r in run_ids]
     params = [r.data.params for r in runs]
     differing = differing_params(params)

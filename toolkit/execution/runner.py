@@ -29,6 +29,7 @@ from toolkit.execution.seeds import derive
 from toolkit.interfaces import EvalContext, Evaluation
 from toolkit.store import h5
 from toolkit.store.tracking import Store, store_root
+from toolkit.store.opening import open_store
 
 
 @dataclasses.dataclass
@@ -93,7 +94,7 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     if cfg.get("cost"):  # what the wait costs, before any work (a prior trained first included)
         _log(f"jt: cost: {cfg.cost}")
     cfg = auto_prior.resolve(cfg, _train_prior)  # action.prior=auto: the store's own prior, trained on first use
-    store = Store(store_root(str(cfg.store)))
+    store = open_store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)
     nested = bool(getattr(search_cls, "nested", True))
     container = OmegaConf.to_container(cfg, resolve=True)

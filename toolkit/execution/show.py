@@ -15,9 +15,10 @@ IMAGES = (".png", ".gif", ".jpg", ".jpeg")
 
 def show(run_id: str, store_path: Optional[str] = None, artifact: Optional[str] = None) -> str:
     """Text description of run ``run_id`` in the store (or of its artifact ``artifact``)."""
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import store_root
+    from toolkit.store.opening import open_store
 
-    store = Store(store_root(store_path), must_exist=True)  # reading never creates a store
+    store = open_store(store_root(store_path), must_exist=True)  # reading never creates a store
     run = store.get_run(run_id)
     art = store.artifact_dir(run_id)
     if artifact is not None:

@@ -73,11 +73,12 @@ def resolve(cfg: Any, train: Callable[[Any, Sequence[str], str], str], train_ove
     overrides = prior_run(cfg)
     if not overrides:
         return cfg
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import store_root
+    from toolkit.store.opening import open_store
 
     kind = str(cfg.action.name)
     experiment = next(o.partition("=")[2] for o in overrides if o.startswith("task="))
-    store = Store(store_root(str(cfg.store)))
+    store = open_store(store_root(str(cfg.store)))
     smoke = str(cfg.get("profile", "default")) == "smoke"  # a smoke run gets a smoke-sized prior
     tag = f"{kind}@smoke" if smoke else kind
     run_id = find(store, tag, experiment)

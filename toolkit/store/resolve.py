@@ -72,16 +72,17 @@ def is_path(ref: str) -> bool:
 def open_store(store: Any) -> Any:
     """The ``Store`` at ``store`` (``store_root`` rules), or None when it has no ``mlflow.db``.
 
-    Unlike ``Store(...)`` this never creates a store; an open ``Store`` is returned as it is.
+    Unlike ``opening.open_store`` this never creates a store; an open ``Store`` is returned as it is.
     """
+    from toolkit.store import opening
     from toolkit.store.tracking import Store, is_server_uri, store_root
 
     if isinstance(store, Store):
         return store
     root = store_root(store)
-    if is_server_uri(root):  # a tracking server: it exists or Store says so in one line
-        return Store(root)
-    return Store(root) if (root / "mlflow.db").is_file() else None
+    if is_server_uri(root):  # a tracking server: it exists or the store says so in one line
+        return opening.open_store(root)
+    return opening.open_store(root) if (root / "mlflow.db").is_file() else None
 
 
 def _quoted(value: Any) -> str:

@@ -90,21 +90,16 @@ class Store:
     for artifacts, ``<root>/work/<run>/`` for evaluation working folders (checkpoints).
 
     Args:
-        root: store directory (created if missing), or an MLflow server URI (``http://host:port``),
-            for which a ``toolkit.store.server.ServerStore`` is returned.
+        root: store directory (created if missing); a store given as ``store=`` (a folder or an
+            MLflow server URI, ``http://host:port``) is opened with ``toolkit.store.opening.open_store``.
     """
 
     is_server = False
     """Whether the store is an MLflow tracking server (``toolkit.store.server.ServerStore``)."""
 
-    def __new__(cls, root: str | os.PathLike, *args: Any, **kwargs: Any) -> "Store":
-        if cls is Store and is_server_uri(str(root)):
-            from toolkit.store.server import ServerStore
-
-            return super().__new__(ServerStore)
-        return super().__new__(cls)
-
     def __init__(self, root: str | os.PathLike, must_exist: bool = False) -> None:
+        if is_server_uri(str(root)):  # never a local folder named after a URL
+            raise ValueError(f"{root} is a server URI: open it with toolkit.store.opening.open_store")
         self.root = Path(root).resolve()
         self.uri = f"sqlite:///{self.root / 'mlflow.db'}"
         check_root(self.root, must_exist)

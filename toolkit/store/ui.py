@@ -161,9 +161,9 @@ def serve(root: Path, port: int) -> int:
     """
     check(root, port)
     if not (root / "mlflow.db").is_file():
-        from toolkit.store.tracking import Store
+        from toolkit.store.opening import open_store
 
-        Store(root)
+        open_store(root)
     cmd, env = command(root, port)
     # its own process group, led by the guard (toolkit.store.ui_guard): stopping jt stops MLflow's
     # server process and its worker together, also where a shell started jt in the background

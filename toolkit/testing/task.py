@@ -46,7 +46,9 @@ def _finished_run(task: str, overrides: list, store: Any, pythonpath: str = "") 
     import subprocess
     import sys
 
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.tracking import store_root
+
+    from toolkit.store.opening import open_store
 
     env = dict(os.environ)
     if pythonpath:
@@ -57,7 +59,7 @@ def _finished_run(task: str, overrides: list, store: Any, pythonpath: str = "") 
     assert out.returncode == 0, out.stderr[-2000:]
     m = re.search(r"run ([0-9a-f]{32}) FINISHED", out.stdout)
     assert m, out.stdout[-2000:]
-    return Finished(m.group(1), Store(store_root(str(store))))
+    return Finished(m.group(1), open_store(store_root(str(store))))
 
 
 def _evaluation_runs(res: Any) -> list:

@@ -39,7 +39,7 @@ from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
 from toolkit.policy.env import CharacterEnv
 from toolkit.policy.spec import default_of
-from jt_tasks.runup.task import RunupConfig as _C
+from jt_tasks.runup.config import RunupConfig as _C
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 

@@ -54,9 +54,10 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
     """``windows`` of every run in ``run_ids`` (``run``, ``survival_s`` added to each row)."""
     from omegaconf import OmegaConf
 
-    from toolkit.store.tracking import Store, store_root
+    from toolkit.store.opening import open_store
+    from toolkit.store.tracking import store_root
 
-    st = Store(store_root(store), must_exist=True)
+    st = open_store(store_root(store), must_exist=True)
     out = []
     for rid in run_ids:
         run = st.get_run(rid)  # an unknown id is one JtError line

@@ -90,7 +90,7 @@ def test_runup_spec_defaults_are_its_configs():
     """The same for RunupSpec and RunupConfig; target is the task's resolved take-off features."""
     from toolkit.policy.spec import shared_fields
     from jt_tasks.runup.env import RunupSpec
-    from jt_tasks.runup.task import RunupConfig
+    from jt_tasks.runup.config import RunupConfig
 
     shared = set(shared_fields(RunupSpec, RunupConfig)) - {"target"}
     assert {"kind", "omega_y", "clip", "w_goal", "goal_steps"} <= shared

@@ -22,7 +22,8 @@ from toolkit.errors import JtError
 from toolkit.execution.heartbeat import HEARTBEAT_TAG, OWNER_TAG, STALE_S, Heartbeat, check_not_owned
 from toolkit.execution.runner import run
 from toolkit.store import h5
-from toolkit.store.server import cache_root
+from toolkit.store.opening import open_store
+from toolkit.store.server import ServerStore, cache_root
 from toolkit.store.tracking import Store, is_server_uri, store_root
 
 HAVE_RAY = importlib.util.find_spec("ray") is not None
@@ -89,8 +90,13 @@ def test_uri_rules(tmp_path, monkeypatch):
     assert cache_root("http://head:5000") == (tmp_path / "w" / "head_5000").resolve()
     t0 = time.monotonic()
     with pytest.raises(JtError, match="no MLflow server answers there"):
-        Store(f"http://127.0.0.1:{free_port()}")
+        open_store(f"http://127.0.0.1:{free_port()}")
     assert time.monotonic() - t0 < 10
+    monkeypatch.chdir(tmp_path)  # a local Store never takes a URI for a folder name
+    with pytest.raises(ValueError, match="server URI"):
+        Store("http://127.0.0.1:5000")
+    assert not (tmp_path / "http:").exists()
+    assert type(open_store(tmp_path / "local")) is Store and issubclass(ServerStore, Store)
 
 
 @pytest.mark.parametrize("name", ["bds", "ppo"])
@@ -177,7 +183,7 @@ def test_interrupted_run_resumes_through_the_server(server, example_plugin_dir, 
             proc.communicate()
     run_id = err.split("jt: run ", 1)[1].split()[0]
     assert f"jt run resume={run_id} store={server.uri}" in err
-    store = Store(server.uri)
+    store = open_store(server.uri)
     tags = store.get_run(run_id).data.tags
     assert tags[HEARTBEAT_TAG] == "stopped" and f"pid {proc.pid} on " in tags[OWNER_TAG]
     # another machine's driver that beat a moment ago owns it: refused in one line, nothing changed
@@ -199,7 +205,7 @@ def test_the_heartbeat_beats_and_stops(server, tmp_path, monkeypatch):
     """The owner's tags on a real server: set at start, renewed every period, ``stopped`` at the
     end; ``check_not_owned`` refuses only another host's fresh beat."""
     monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
-    store = Store(server.uri)
+    store = open_store(server.uri)
     rid = store.start_run("heartbeat", run_name="hb")
     hb = Heartbeat(store, rid, period_s=0.4).start()
     try:
@@ -222,7 +228,7 @@ def test_the_heartbeat_beats_and_stops(server, tmp_path, monkeypatch):
 def test_of_two_resumes_at_once_only_the_last_to_write_goes_on(server, tmp_path, monkeypatch):
     """Both write ``jt.owner``; read back after the confirm delay, only the one named there stays."""
     monkeypatch.setenv("JT_WORK_DIR", str(tmp_path / "cache"))
-    store = Store(server.uri)
+    store = open_store(server.uri)
     rid = store.start_run("heartbeat", run_name="race")
     first = Heartbeat(store, rid, period_s=60).start()
     second = Heartbeat(store, rid, period_s=60).start()
