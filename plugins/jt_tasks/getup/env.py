@@ -117,6 +117,8 @@ class GetupEnv(CharacterEnv):
         self.control_hz = float(self.sim.control_hz)
         self.dt = 1.0 / self.control_hz
         self._m = self._lv = self._ahead = None  # this state's measurements, link velocities, targets
+        self.torso_links = F.torso_links(self.sim)  # resolved once: measured every step
+        self.head_link = self.sim.link_index(F.HEAD)
         self.terms = self.load_terms((spec.reward or {}).get("terms"))
         self.natural = set(spec.natural_terms)
         q_stand, qd_stand = clip_pose("getup_facedown", False, frame=-1)
@@ -183,10 +185,10 @@ class GetupEnv(CharacterEnv):
 
     def _head_contact(self) -> bool:
         """The head link touches the ground plane or the terrain."""
-        return any(link == F.HEAD_LINK and body in self.ground_bodies for body, link in self.sim.contacts())
+        return any(link == self.head_link and body in self.ground_bodies for body, link in self.sim.contacts())
 
     def _head_height(self) -> float:
-        lo, _ = self.sim.aabb(F.HEAD_LINK)
+        lo, _ = self.sim.aabb(self.head_link)
         return float(lo[1]) - float(np.min(self.measure()["ground"]))
 
     @property
@@ -261,7 +263,7 @@ class GetupEnv(CharacterEnv):
 
     # ------------------------------------------------------------------ measurements
     def _measure_now(self) -> dict[str, Any]:
-        return F.measure(self.sim, self.spec_.heightmap_n, self.spec_.heightmap_spacing)
+        return F.measure(self.sim, self.spec_.heightmap_n, self.spec_.heightmap_spacing, links=self.torso_links)
 
     def measure(self) -> dict[str, Any]:
         """Features, heading and height map of the current state (cached until the next step)."""

@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 
 UP = np.array([0.0, 1.0, 0.0])
-NECK_LINK, RIGHT_HIP_LINK, LEFT_HIP_LINK = 2, 3, 9  #: humanoid joint-origin links (PyBullet indices)
-HEAD_LINK = 2  #: the neck link carries the head sphere
+#: the humanoid's links whose joint origins give the style features (names; ``torso_links``)
+NECK, RIGHT_HIP, LEFT_HIP = "neck", "right_hip", "left_hip"
+HEAD = "neck"  #: the neck link carries the head sphere
 #: below this horizontal norm of ``up × side`` the heading falls back to the torso axis (ours)
 SIDE_FALLBACK = 0.3
 
@@ -85,8 +86,21 @@ def heightmap_points(centre: np.ndarray, yaw: float, n: int = 5, spacing: float 
     return world + np.array([centre[0], centre[1], centre[2]])
 
 
-def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0) -> dict[str, Any]:
+def torso_links(sim: Any) -> tuple[int, int, int]:
+    """The simulator's link indices of ``NECK``, ``RIGHT_HIP``, ``LEFT_HIP`` (for ``measure``)."""
+    return sim.link_index(NECK), sim.link_index(RIGHT_HIP), sim.link_index(LEFT_HIP)
+
+
+def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0,
+            links: Any = None) -> dict[str, Any]:
     """Style features, heading and height map of the simulator's current state.
+
+    Args:
+        sim: the simulator, holding the state.
+        n, spacing: the height map's grid (``heightmap_points``).
+        ray_span: m above and below the hips that its rays span.
+        links: ``torso_links(sim)``, resolved once by a caller that measures every step; None:
+            resolved here.
 
     Returns:
         ``features`` (h, θx, θz) ``(3,)``, ``yaw``, ``heightmap`` ``(n * n,)`` (hip height above
@@ -95,7 +109,7 @@ def measure(sim: Any, n: int = 5, spacing: float = 0.25, ray_span: float = 5.0) 
     """
     from jt_tasks.getup import kernels
 
-    neck, r_hip, l_hip = sim.link_poses((NECK_LINK, RIGHT_HIP_LINK, LEFT_HIP_LINK))[0]
+    neck, r_hip, l_hip = sim.link_poses(torso_links(sim) if links is None else links)[0]
     starts, ends, torso = np.empty((n * n, 3)), np.empty((n * n, 3)), np.empty(6)
     # heading_yaw, heightmap_points and torso_vectors in one compiled pass (the same formulas)
     yaw = kernels.frame(neck, r_hip, l_hip, n, spacing, ray_span, SIDE_FALLBACK, starts, ends, torso)

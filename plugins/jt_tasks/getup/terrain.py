@@ -206,7 +206,8 @@ def place_on_ground(sim: Any, q: np.ndarray, qd: np.ndarray, xz: Any, clearance:
     return q
 
 
-FEET = (("right_ankle", 5, 4), ("left_ankle", 11, 10))  #: (joint, foot link, its parent link) of the humanoid
+#: (joint, foot link, its parent link) of the humanoid, by name (``Simulator.link_index``)
+FEET = (("right_ankle", "right_ankle", "right_knee"), ("left_ankle", "left_ankle", "left_knee"))
 
 
 def ground_normal(sim: Any, x: float, z: float, d: float = 0.08) -> np.ndarray:
@@ -232,8 +233,8 @@ def orient_feet(sim: Any, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     q = np.array(q, dtype=np.float64)
     up = np.array([0.0, 1.0, 0.0])
     for joint, link, parent in FEET:
-        pos, foot = sim.link_pose(link)
-        _, par = sim.link_pose(parent)
+        pos, foot = sim.link_pose(sim.link_index(link))
+        _, par = sim.link_pose(sim.link_index(parent))
         n = ground_normal(sim, float(pos[0]), float(pos[2]))
         a = rot.quat_rotate(foot, up)  # the sole's normal now
         axis = np.cross(a, n)

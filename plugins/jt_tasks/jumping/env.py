@@ -44,7 +44,7 @@ from toolkit.policy.spec import default_of
 from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
 from toolkit.interfaces.simulator import ContactRule, Watch
 
-HEAD_LINK = 2  #: the humanoid's neck link carries the head (PyBullet link index)
+HEAD = "neck"  #: the humanoid's link that carries the head (by name; ``setup`` resolves it)
 
 
 @dataclasses.dataclass
@@ -91,7 +91,8 @@ class JumpEnv(CharacterEnv):
     # ------------------------------------------------------------------ set-up (scene, initial state)
     def setup(self) -> None:
         spec = self.spec_
-        self.foot_link = FOOT_LINKS[spec.foot]
+        self.foot_link = self.sim.link_index(FOOT_LINKS[spec.foot])
+        self.head_link = self.sim.link_index(HEAD)
         self.terms = self.load_terms(spec.reward_terms)
         self.suite = Suite(self.sim, spec.suite)
         feats = {k: float(v) for k, v in spec.features.items() if k != "alpha"}
@@ -229,7 +230,7 @@ class JumpEnv(CharacterEnv):
                 return self._finish(False, f"passed beside the {what}")
         mat = rec["touched"].get(self.suite.mat_id)
         if mat is not None and not self.landed:
-            self.landed, self.head_first = True, HEAD_LINK in mat
+            self.landed, self.head_first = True, self.head_link in mat
         status, reason = rec["outcome"], self.failure(rec) or rec["reason"]
         w = rec["qd"][3:6]  # the step record's state is the simulator's state now
         self._ang_speeds.append(math.sqrt(w.dot(w)))  # np.linalg.norm's own sum, without its overhead

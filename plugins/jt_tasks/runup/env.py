@@ -73,7 +73,11 @@ class RunupEnv(CharacterEnv):
         spec = self.spec_
         self.targets = rw.goal_targets(spec.kind, spec.target, spec.omega_y)
         self.substeps = max(1, int(round(self.sim_hz / self.control_hz)))
-        self.feet = {FOOT_LINKS["right"], FOOT_LINKS["left"]}
+        self.feet = {self.sim.link_index(FOOT_LINKS["right"]), self.sim.link_index(FOOT_LINKS["left"])}
+        # rows of the end effectors in links_and_com (base first) of the simulator and of the
+        # reference's kinematic body alike: the humanoid skeleton's link order is the simulator's
+        # link indices (tests/plugins/jt_tasks/test_link_names.py)
+        self.ee_rows = [self.sim.link_index(name) + 1 for name in END_EFFECTORS]
         self.ref = RunReference(spec.clip, spec.foot, spec.contact_tol, spec.foot_clearance, self.sim_hz)
         # DeepMimic's early termination: a body part other than the feet touches the ground
         self.watch = Watch(rules=(ContactRule(self.sim.ground, "fail", "fell", except_links=tuple(sorted(self.feet))),),
@@ -126,7 +130,7 @@ class RunupEnv(CharacterEnv):
         q, qd = self.sim.state()
         ref = self.ref.at(self.j0 + self.substeps_done)
         links, com = self.links_and_com()
-        ee = [i + 1 for i in END_EFFECTORS]  # base is row 0
+        ee = self.ee_rows  # base is row 0
         return rw.imitation_terms(self.skeleton, q, qd, facing_frame(q, links[ee]), com,
                                   ref.q, ref.qd, facing_frame(ref.q, ref.links[ee]), ref.com)
 

@@ -30,8 +30,9 @@ import numpy as np
 from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat, reference_state, support_phase_time
 from toolkit.motion import rotations as rot
 
-#: hands and feet (PyBullet link indices): the end effectors of Peng et al. 2018 §6
-END_EFFECTORS = (FOOT_LINKS["right"], FOOT_LINKS["left"], 8, 14)
+#: hands and feet by link name: the end effectors of Peng et al. 2018 §6 (the env resolves them
+#: once, ``Simulator.link_index``)
+END_EFFECTORS = (FOOT_LINKS["right"], FOOT_LINKS["left"], "right_wrist", "left_wrist")
 #: ``RunReference.at`` memo: {(clip, foot, contact_tol, clearance, sim_hz): {j: RefSample}}
 _MEMO: dict[tuple, dict[int, "RefSample"]] = {}
 _MEMO_MAX = 20000  # samples per reference (about 33 s of clip time at 600 Hz)
@@ -120,8 +121,16 @@ class RunReference:
         p = p + np.array([0.0, self.ground_offset, 0.0])
         return np.concatenate([p, r, j]), np.concatenate([v, w, jv])
 
-    def lowest_point(self, q: np.ndarray, link: Optional[int] = None) -> float:
-        """Lowest height of a link's bounding box (or of the whole body) in pose ``q``."""
+    def lowest_point(self, q: np.ndarray, link: Optional[int | str] = None) -> float:
+        """Lowest height of a link's bounding box (or of the whole body) in pose ``q``.
+
+        Args:
+            q: the pose ``(n_q,)``.
+            link: a link name, else its index in the skeleton's order (the kinematic body's
+                PyBullet indices); None: every link.
+        """
+        if isinstance(link, str):
+            link = self.skeleton.link_index(link)
         return self.body.lowest_point(q, link)
 
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,10 +28,11 @@ from typing import Any, Mapping, Optional
 
 import numpy as np
 
+from jt_tasks.spacetime.reference import END_EFFECTORS
 
 COM = ("com_x", "com_y", "com_z")
 ROOT = ("root",)
-END_EFFECTOR_NAMES = ("ee_right_ankle", "ee_right_wrist", "ee_left_ankle", "ee_left_wrist")
+END_EFFECTOR_NAMES = tuple(f"ee_{name}" for name in END_EFFECTORS)
 GROUPS = ("com", "orientation", "end_effector")
 
 

@@ -38,7 +38,8 @@ def heading_axis(clip: str, axis: Optional[str] = None) -> str:
 
 def allowed_links(skeleton: Any, clip: str, names: Optional[list] = None) -> tuple[int, ...]:
     """Link indices allowed on the ground: ``names`` (link names, ``base``; ``["all"]``), else the
-    clip's entry of ``ALLOWED_CONTACTS`` (feet by default)."""
+    clip's entry of ``ALLOWED_CONTACTS`` (feet by default). Indices in ``skeleton``'s link order:
+    the humanoid's are the simulator's link indices (tests/plugins/jt_tasks/test_link_names.py)."""
     links = ["base"] + list(skeleton.links)
     index = {n: i - 1 for i, n in enumerate(links)}  # base = -1
     if names is None:

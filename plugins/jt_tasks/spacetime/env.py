@@ -48,7 +48,7 @@ from toolkit.policy.spec import default_of
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig as _C
 from jt_tasks.spacetime import bounds as bd
-from jt_tasks.spacetime.reference import END_EFFECTORS, SpacetimeReference, heading_frame, heading_quat
+from jt_tasks.spacetime.reference import SpacetimeReference, end_effector_links, heading_frame, heading_quat
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 
@@ -99,6 +99,9 @@ class SpacetimeEnv(CharacterEnv):
         spec = self.spec_
         self.axis = clips.heading_axis(spec.clip, spec.heading_axis)
         self.ref = SpacetimeReference(spec.clip, self.axis, spec.loop, spec.cycle_turn)
+        self.ee_links = end_effector_links(self.sim)  # resolved once: the bounds read them every step
+        # allowed contacts by the skeleton's link order: the simulator's link indices on the humanoid
+        # (tests/plugins/jt_tasks/test_link_names.py)
         per_clip = clips.allowed_links(self.skeleton, spec.clip)
         self.train_allowed = per_clip if spec.train_allowed is None else tuple(spec.train_allowed)
         self.eval_allowed = per_clip if spec.eval_allowed is None else tuple(spec.eval_allowed)
@@ -194,7 +197,7 @@ class SpacetimeEnv(CharacterEnv):
     def body_state(self) -> bd.BodyState:
         """What the bounds compare of the simulated character now."""
         q, _ = self.sim.state()
-        ee = self.sim.link_poses(END_EFFECTORS)[0]
+        ee = self.sim.link_poses(self.ee_links)[0]
         return bd.BodyState(q, np.asarray(self.sim.com(), dtype=float),
                             heading_frame(q, ee, self.axis, self.heading_inverse()))
 
@@ -205,7 +208,7 @@ class SpacetimeEnv(CharacterEnv):
 
         ref = self.ref.sample(self.clip_time)
         q, _ = self.sim.state()
-        ee = self.sim.link_poses(END_EFFECTORS)[0]
+        ee = self.sim.link_poses(self.ee_links)[0]
         out = np.zeros(len(self.names))  # the wrists (fixed joints) stay 0
         kernels.difference(np.asarray(q, dtype=float), np.asarray(self.sim.com(), dtype=float), ee, ref.q, ref.com,
                            ref.ee, self.axis == "z", *bd._angle_columns(self.skeleton), out)

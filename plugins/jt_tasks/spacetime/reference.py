@@ -33,16 +33,27 @@ import bisect
 import dataclasses
 import math
 import os
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from toolkit.motion import rotations as rot
 
-#: end-effector links (PyBullet link index = joint index) in the authors' bound-file order: right
-#: ankle, right wrist, left ankle, left wrist (their data/bounds readme, channels 18-21)
-END_EFFECTORS = (5, 8, 11, 14)
+#: end-effector links by name in the authors' bound-file order (their data/bounds readme, channels
+#: 18-21); ``end_effector_links`` turns them into indices
+END_EFFECTORS = ("right_ankle", "right_wrist", "left_ankle", "left_wrist")
 HEADING_AXES = {"x": np.array([1.0, 0.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+def end_effector_links(character: Any) -> tuple[int, ...]:
+    """The link indices of ``END_EFFECTORS``, resolved once by their user.
+
+    Args:
+        character: anything with ``link_index(name)``: the simulator (``Simulator.link_index``)
+            or a mocap skeleton (``Skeleton.link_index``, whose link order is the humanoid's
+            PyBullet link indices).
+    """
+    return tuple(int(character.link_index(name)) for name in END_EFFECTORS)
 
 
 def resolve_clip(name: str) -> str:
@@ -166,8 +177,9 @@ class SpacetimeReference:
             body.close()
         m = self.masses
         self._com = (m[0] * c.root_pos + np.einsum("l,fld->fd", m[1:], kin.link_com)) / m.sum()
+        ee = list(end_effector_links(c.skeleton))
         self._ee = np.stack([heading_frame(np.concatenate([c.root_pos[i], c.root_rot[i]]),
-                                           kin.joint_pos[i, list(END_EFFECTORS)], heading_axis)
+                                           kin.joint_pos[i, ee], heading_axis)
                              for i in range(c.n_frames)])
         self._times = [float(x) for x in c.times]
         self.turn = 0.0

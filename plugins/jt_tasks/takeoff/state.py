@@ -30,7 +30,9 @@ from toolkit.motion import rotations as rot
 
 FEATURE_NAMES = {"highjump": ("alpha", "omega_x", "omega_z", "v_z"),
                  "obstacle": ("omega_x", "omega_y", "omega_z")}
-FOOT_LINKS = {"right": 5, "left": 11}  #: PyBullet link index of each ankle (humanoid, docs/motion.md)
+#: the link of each ankle by name (humanoid); the simulator (``Simulator.link_index``) or the
+#: skeleton (``Skeleton.link_index``) turns it into an index where it is used
+FOOT_LINKS = {"right": "right_ankle", "left": "left_ankle"}
 
 
 @dataclasses.dataclass
@@ -66,7 +68,7 @@ def support_phase_time(clip: Any, foot: str, contact_tol: float = 0.06) -> tuple
         ``(time, (first_frame, last_frame))`` of the support phase (frames may wrap around).
     """
     kin = clip.fk()
-    h = kin.link_com[:, FOOT_LINKS[foot], 1]
+    h = kin.link_com[:, clip.skeleton.link_index(FOOT_LINKS[foot]), 1]
     stance = h < h.min() + contact_tol
     n = len(h)
     if stance.all():

@@ -21,10 +21,11 @@ class StandSpec:                      # picklable: rollout workers rebuild the e
     time_limit: float = default_of(StandConfig, "time_limit")  # one default: the Config's
 
 class StandEnv(CharacterEnv):
-    FEET = (5, 11)                    # the humanoid's ankle links
+    FEET = ("right_ankle", "left_ankle")  # the humanoid's ankle links, by name
 
     def setup(self):                  # scene + termination rules, checked inside the 600 Hz loop
-        self.watch = Watch(rules=(ContactRule(self.sim.ground, "fail", "fell", except_links=self.FEET),),
+        feet = tuple(self.sim.link_index(n) for n in self.FEET)  # names -> indices, once
+        self.watch = Watch(rules=(ContactRule(self.sim.ground, "fail", "fell", except_links=feet),),
                            time_limit=self.spec_.time_limit, time_limit_outcome="truncate")
         self.q0, self.qd0 = self.sim.state()
 

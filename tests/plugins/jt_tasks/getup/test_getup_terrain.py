@@ -170,7 +170,7 @@ def test_standing_starts_on_a_slope_get_their_feet_turned_to_it(world):
     def sole_angles() -> list[float]:
         out = []
         for _, link, _ in T.FEET:
-            pos, foot = sim.link_pose(link)
+            pos, foot = sim.link_pose(sim.link_index(link))
             a = rot.quat_rotate(foot, np.array([0.0, 1.0, 0.0]))
             out.append(math.degrees(math.acos(min(1.0, float(a @ T.ground_normal(sim, pos[0], pos[2]))))))
         return out

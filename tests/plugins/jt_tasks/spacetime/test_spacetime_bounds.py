@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from jt_tasks.spacetime import bounds as bd
-from jt_tasks.spacetime.reference import END_EFFECTORS, SpacetimeReference, heading_frame
+from jt_tasks.spacetime.reference import SpacetimeReference, end_effector_links, heading_frame
 from toolkit.errors import JtError
 from toolkit.motion import rotations as rot
 from toolkit.motion.skeletons import HUMANOID
@@ -41,7 +41,7 @@ def test_channels_are_in_the_order_of_the_authors_bound_files():
     from toolkit.motion.skeletons import HUMANOID as H
 
     links = ["base"] + list(H.links)
-    assert [links[i + 1] for i in END_EFFECTORS] == ["right_ankle", "right_wrist", "left_ankle", "left_wrist"]
+    assert [links[i + 1] for i in end_effector_links(H)] == ["right_ankle", "right_wrist", "left_ankle", "left_wrist"]
 
 
 def test_22_channels_in_the_authors_order_with_the_paper_widths():
@@ -117,7 +117,7 @@ def test_end_effector_channels_are_invariant_under_a_shared_yaw_and_translation(
 
     def ee(q):
         kin = forward_kinematics(HUMANOID, q[None, :3], q[None, 3:7], q[None, 7:])
-        return heading_frame(q, kin.joint_pos[0, list(END_EFFECTORS)], axis)
+        return heading_frame(q, kin.joint_pos[0, list(end_effector_links(HUMANOID))], axis)
 
     def moved(q):
         out = q.copy()
