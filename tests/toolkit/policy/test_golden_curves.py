@@ -35,6 +35,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from toolkit.testing.golden import machine_key
+
 GOLDEN = Path(__file__).parent / "golden"
 TIMING = {"samples_per_s", "collect_s", "update_s"}
 
@@ -54,25 +56,6 @@ def _tree(path: Path, group: str = "") -> dict:
                     walk(g[k], pre + k + "/")
         walk(f[group] if group else f, "")
     return out
-
-
-def machine_key() -> str:
-    """A short hash of what a curve's last digits depend on: CPU model, numpy's enabled SIMD
-    features, torch's CPU capability, numpy's and torch's versions."""
-    import hashlib
-    import platform
-
-    import torch
-
-    cpu = platform.processor()
-    if Path("/proc/cpuinfo").exists():
-        cpu = next((ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
-                    if ln.startswith("model name")), cpu)
-    core = getattr(np, "_core", None) or np.core
-    feats = sorted(k for k, v in core._multiarray_umath.__cpu_features__.items() if v)
-    text = "|".join([platform.machine(), cpu, str(torch.backends.cpu.get_cpu_capability()), np.__version__,
-                     torch.__version__, ",".join(feats)])
-    return hashlib.sha1(text.encode()).hexdigest()[:10]
 
 
 @pytest.mark.parametrize("task", ["highjump", "runup"])
