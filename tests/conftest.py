@@ -6,6 +6,7 @@ No test module goes directly in tests/plugins/ (tests/toolkit/testing/test_test_
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -18,11 +19,14 @@ FIXTURE_PLUGIN = ROOT / "tests" / "fixtures" / "jt_example_plugin"
 
 @pytest.fixture(scope="session")
 def example_plugin_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """jt-example-plugin installed with pip into a private target directory (a real install)."""
+    """jt-example-plugin installed with pip into a private target directory (a real install), built
+    from a copy so that test workers running side by side never share a ``build/`` folder."""
+    src = tmp_path_factory.mktemp("example_src") / FIXTURE_PLUGIN.name
+    shutil.copytree(FIXTURE_PLUGIN, src, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
     target = tmp_path_factory.mktemp("site")
     subprocess.run(
         [sys.executable, "-m", "pip", "install", "--no-deps", "--no-build-isolation", "-q",
-         "--disable-pip-version-check", "--target", str(target), str(FIXTURE_PLUGIN)],
+         "--disable-pip-version-check", "--target", str(target), str(src)],
         check=True, capture_output=True,
     )
     return target
@@ -86,7 +90,11 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     interpreter finalisation: a clean clone's full run once passed every test and then died in a
     segmentation fault at exit (2026-12-06, rc 139; the kernel log places it in a background
     thread, as C extensions' threads that outlive the interpreter (Ray's core worker, gRPC) can),
-    which would turn a green suite red. ``JT_TEST_FINALIZE=1`` lets Python finalise normally."""
+    which would turn a green suite red. ``JT_TEST_FINALIZE=1`` lets Python finalise normally.
+    Only the controlling process ends this way: a pytest-xdist worker (``config.workerinput``) hands
+    its reports to the controller over a channel that must be closed normally."""
+    if hasattr(config, "workerinput"):
+        return
     if "status" in _SESSION and os.environ.get("JT_TEST_FINALIZE") != "1":
         sys.stdout.flush()
         sys.stderr.flush()
