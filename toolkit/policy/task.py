@@ -48,7 +48,31 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
 
         store = str(group_of(action, "store") or "").strip() or group_of(cfg, "store")  # action.store first
         load_prior(prior, None if store is None else str(store), name)  # format, kind, shapes: one line each
-    trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
+    path = trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
+    if path is not None:
+        check_policy_fits(cfg, task, path)
+
+
+def check_policy_fits(cfg: Any, task: str, path: Path) -> None:
+    """``task.evaluate``'s policy takes the observation and gives the action of ``task``'s
+    environment as configured (sizes from the checkpoint, against an environment built here):
+    a run of another task, or of other settings, is one ``JtError`` line before a run opens."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+    from toolkit.rl.checkpoint import load_attrs
+
+    attrs = load_attrs(path)
+    want = (int(attrs["obs_dim"]), int(attrs["act_dim"]))
+    env = plugins.load("task", task)(cfg).make_env(seed=0)
+    try:
+        have = (int(env.observation_space.shape[0]), int(env.action_space.shape[0]))
+    finally:
+        env.close()
+    if want != have:
+        ref = str(group_of(group_of(cfg, "task"), "evaluate")).strip()
+        raise JtError(f"task.evaluate={ref}: its policy takes {want[0]} observations and gives {want[1]} actions; "
+                      f"task={task} as configured here observes {have[0]} and acts with {have[1]} "
+                      f"(a run of another task, or of other task/action settings)")
 
 
 def trained_policy(cfg: Any, task: str) -> Optional[Path]:

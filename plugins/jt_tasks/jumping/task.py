@@ -54,6 +54,11 @@ class JumpTask(PolicyTask):
     Config: ClassVar[type] = JumpConfig
     env_path: ClassVar[str] = "jt_tasks.jumping.env:JumpEnv"
     action_inputs: ClassVar[frozenset[str]] = frozenset()  #: neither a phase nor a C-VAE condition
+    #: what JumpEnv.episode_record gives the reward terms
+    record_keys: ClassVar[frozenset[str]] = frozenset({
+        "success", "root_ang_vel_mean", "head_first_landing", "naturalness", "feature", "policy_features"})
+    #: what a curriculum may drive: the jump's own difficulty, the control rate, the P-VAE's offset
+    curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"bar_height", "control_hz", "c_offset"})
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:
@@ -322,6 +327,7 @@ class ObstacleTask(JumpTask):
     kind = "obstacle"
     feature_names = ("omega_x", "omega_y", "omega_z")
     Config = ObstacleConfig
+    curriculum_attrs = frozenset({"obstacle_width", "control_hz", "c_offset"})  # the box's width, not a bar
 
 
 class LongJumpTask(ObstacleTask):

@@ -49,6 +49,8 @@ class RunupTask(PolicyTask):
     Config: ClassVar[type] = RunupConfig
     env_path: ClassVar[str] = "jt_tasks.runup.env:RunupEnv"
     action_inputs: ClassVar[frozenset[str]] = frozenset()  #: neither a phase nor a C-VAE condition
+    #: its reward is its own (imitation + the take-off reward, eqs 13-14) and its difficulty fixed
+    ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum")
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

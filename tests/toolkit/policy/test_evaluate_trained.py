@@ -36,3 +36,22 @@ def test_a_missing_trained_run_is_one_line_before_a_run_opens(tmp_path):
     with pytest.raises(JtError, match=r"task.evaluate=nope: .*train one with: jt run task=runup"):
         compose(["task=runup", "experiment=smoke", f"store={tmp_path}", "task.evaluate=nope"])
     assert not (tmp_path / "mlflow.db").exists()
+
+
+def test_a_policy_of_another_task_is_one_line_before_a_run_opens(tmp_path):
+    """A run-up policy (125 observations) named by task.evaluate for the spacetime walk: refused at
+    composition with both sizes, where it used to fail mid-run on a state_dict size mismatch."""
+    from toolkit.config import compose
+
+    trained = _run(tmp_path)
+    client = trained.store.client
+
+    def n_runs():
+        return len(client.search_runs([e.experiment_id for e in client.search_experiments()]))
+
+    before = n_runs()
+    with pytest.raises(JtError, match=r"task.evaluate=\w+: its policy takes 125 observations and gives 28 actions; "
+                                      r"task=spacetime as configured here observes 148"):
+        compose(["task=spacetime", "experiment=smoke", "action=raw", f"store={tmp_path}",
+                 f"task.evaluate={trained.run_id}"])
+    assert n_runs() == before  # no spacetime run row, not even a failed one
