@@ -3,6 +3,8 @@ calculateMassMatrix / calculateInverseDynamics (where those are exact: revolute-
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pytest
 from dynamics_worlds import CHARACTERS, REVOLUTE_ONLY, SIMULABLE, state_in_limits
@@ -47,19 +49,22 @@ def test_mass_matrix_and_bias_equal_pybullet_fixed_base(worlds, name):
     import pybullet as pb
 
     from toolkit.dynamics.crba import crba
+    from toolkit.dynamics.model import Data
     from toolkit.dynamics.rnea import bias
 
     w = worlds(name, True)
-    w.model.set_base_pose(w.model.tree_p[0], (0, 0, 0, 1))
+    model = copy.deepcopy(w.model)  # the session's world is shared: its own model keeps its base pose
+    model.set_base_pose(model.tree_p[0], (0, 0, 0, 1))
+    data = Data(model)
     rng = np.random.default_rng(3)
     for _ in range(3):
-        q, qd = w.model.random_state(rng)
+        q, qd = model.random_state(rng)
         M_pb = np.array(pb.calculateMassMatrix(w.character.body_id, q.tolist(),
                                                physicsClientId=w.client))
         C_pb = np.array(pb.calculateInverseDynamics(w.character.body_id, q.tolist(), qd.tolist(),
                                                     [0.0] * len(q), physicsClientId=w.client))
-        M = crba(w.model, w.data, q)
-        C = bias(w.model, w.data, q, qd)
+        M = crba(model, data, q)
+        C = bias(model, data, q, qd)
         assert np.allclose(M, M_pb, rtol=1e-9, atol=1e-10 * np.abs(M).max())
         assert np.allclose(C, C_pb, rtol=1e-9, atol=1e-9 * np.abs(C).max())
 

@@ -170,9 +170,10 @@ def test_runs_read_well_in_the_ui(example_plugin, store_dir):
     """What a researcher meets in ``jt ui``: finals and curves under distinct keys, each logged once,
     curve points with their own times, descriptions, MLflow's user/commit tags, an experiment
     description, the outer run's summary picture and table, HDF5 previews, no store outside the store."""
-    cfg = compose(["task=quadratic", "task.sleep=0.05", "search=random", "search.budget=2", "search.batch=2",
-                   "executor.workers=1", f"store={store_dir}", "seed=4"])
-    res = run(cfg)
+    args = ["task=quadratic", "task.sleep=0.05", "search=random", "search.budget=2", "search.batch=2",
+            "executor.workers=1", f"store={store_dir}", "seed=4"]
+    command = " ".join(["jt", "run", *args])  # as the CLI passes it (this process's argv is pytest's)
+    res = run(compose(args), command=command)
     store = res.store
     outer = store.get_run(res.run_id)
     child = store.client.search_runs([outer.info.experiment_id],
@@ -197,7 +198,7 @@ def test_runs_read_well_in_the_ui(example_plugin, store_dir):
     tags = outer.data.tags
     assert tags["mlflow.user"] and tags["mlflow.source.git.commit"] == tags["jt.git_commit"].split("+")[0]
     desc = tags["mlflow.note.content"]
-    assert "Reproduce: `jt " in desc and "| n_evaluations | 2 |" in desc and "`points.png`" in desc
+    assert f"Reproduce: `{command}`" in desc and "| n_evaluations | 2 |" in desc and "`points.png`" in desc
     assert "| eval | x0 | x1 | value |" in desc  # the task's summary_table, as markdown
     art = store.artifact_dir(res.run_id)
     assert (art / "points.png").stat().st_size > 1000  # the task's summary_artifacts, on the outer run
