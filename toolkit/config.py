@@ -181,11 +181,15 @@ def compose(overrides: Sequence[str] = (), run_checks: bool = True) -> Any:
     from hydra import initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
-    from toolkit.schema import validate
+    from toolkit.schema import ignored_choice, validate
 
     overrides = list(overrides)
     parsed = _parse(overrides)
     _check_choices(parsed)
+    task = _choice(parsed, "task")
+    for ov in parsed:  # a group with a default that the task never reads (the optional ones: run_checks)
+        if task is not None and not ov.is_delete() and not ov.package:
+            ignored_choice(task, ov.key_or_group, ov.value())
     hydra_overrides, deferred = [], []
     for text, ov in zip(overrides, parsed):
         if _defer(ov):

@@ -253,13 +253,28 @@ def _common_keys(where: str, cls: type, schema: type, node: Any,
     return plain, [(k, v) for k, v in overrides if k.split(".")[0] not in keys]
 
 
+#: the groups a config may lack (no default): present means chosen, by a preset or the command line
+OPTIONAL_GROUPS = ("action", "reward", "curriculum")
+
+
+def ignored_choice(task: str, key: str, value: Any) -> None:
+    """A command-line ``key=value`` (a group choice or ``group.field=...``) for a group with a
+    default that ``task`` never reads (``Task.ignores_groups``): one ``JtError`` line."""
+    group = key.split(".")[0]
+    if group in OPTIONAL_GROUPS or task not in plugins.names("task"):
+        return
+    if group in getattr(plugins.load("task", task), "ignores_groups", ()):
+        article = "an" if group[0] in "aeiou" else "a"
+        raise JtError(f"task={task} does not read {article} {group} group; drop {key}={value} (it would be ignored)")
+
+
 def run_checks(cfg: Any) -> None:
     """The chosen plugins' cross-group checks (``Plugin.check_run``) of a validated config, and
-    no group chosen that the task never reads (``Task.ignores_groups``)."""
+    no optional group chosen that the task never reads (``Task.ignores_groups``)."""
     task = cfg.get("task")
     if task is not None and "name" in task:
         ignored = getattr(plugins.load("task", str(task["name"])), "ignores_groups", ())
-        chosen = [g for g in ignored if cfg.get(g) is not None]
+        chosen = [g for g in ignored if g in OPTIONAL_GROUPS and cfg.get(g) is not None]
         if chosen:
             g = chosen[0]
             what = cfg[g].get("name", "") if hasattr(cfg[g], "get") else ""

@@ -37,7 +37,7 @@ PAPER_UPDATES = {"pvae": math.ceil(20000 / 128) * 80, "cvae": math.ceil(36000 / 
 class PosePriorTask(Task):
     """Train the P-VAE (000 §4.2) or C-VAE (003 §3.5) pose prior for the run's action space."""
 
-    ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum")
+    ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum", "sim", "spd", "character", "agent")
 
     key_metrics: ClassVar[tuple[str, ...]] = ("latent_dim", "recon_rmse_heldout", "pca_rmse_heldout")
 

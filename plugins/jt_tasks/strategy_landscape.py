@@ -31,7 +31,7 @@ from toolkit.errors import JtError
 class StrategyLandscapeTask(Task):
     """Synthetic box of hidden strategy cells (unequal sizes) with plateau features + noise."""
 
-    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum", "sim", "spd", "character", "agent")
 
     key_metrics: ClassVar[tuple[str, ...]] = ("distinct_at_10", "distinct_strategies")
 

@@ -57,7 +57,7 @@ def hypervolume(F: np.ndarray, ref: Sequence[float]) -> float:
 class ZDT1Task(Task):
     """ZDT1 bi-objective benchmark with its exact front hypervolume."""
 
-    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+    ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum", "sim", "spd", "character", "agent")
 
     key_metrics: ClassVar[tuple[str, ...]] = ("hv_ratio", "hypervolume")
 

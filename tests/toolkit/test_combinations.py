@@ -46,8 +46,8 @@ def _outcome(overrides: list[str], store) -> str:
 
 @pytest.mark.parametrize("task", plugins.names("task"))
 def test_each_choice_composes_or_is_one_line(task, tmp_path):
-    outcomes = {}
     store = tmp_path / "store"
+    outcomes = {"(the smoke preset alone)": _outcome([f"task={task}", "experiment=smoke"], store)}
     for group, kind in GROUPS.items():
         for choice in _choices(kind):
             outcomes[f"{group}={choice}"] = _outcome([f"task={task}", "experiment=smoke", f"{group}={choice}"], store)
@@ -63,6 +63,13 @@ def test_each_choice_composes_or_is_one_line(task, tmp_path):
     (["task=spacetime", "curriculum=terrain"], "does not read a curriculum group"),
     (["task=getup", "curriculum=bar_height"], "drives bar_height"),
     (["task=getup", "action=ffc_fbc"], "needs phase from the task"),
+    (["task=highjump", "reward=getup"], "reads record key(s) h, target_h"),
+    (["task=highjump", "curriculum=terrain"], "drives terrain_level"),
+    (["task=obstacle", "curriculum=bar_height"], "drives bar_height"),
+    (["task=runup", "reward=highjump"], "does not read a reward group"),
+    (["task=zdt1", "character=laikago"], "does not read a character group"),
+    (["task=pose_prior", "agent=ppo_getup"], "does not read an agent group"),
+    (["task=strategy_landscape", "character.kp=5"], "drop character.kp=5"),
 ])
 def test_the_pairs_that_failed_mid_run_are_refused_first(overrides, words, tmp_path):
     out = _outcome([*overrides, "experiment=smoke"], tmp_path / "store")

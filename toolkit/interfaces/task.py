@@ -81,9 +81,11 @@ class Task(Plugin, abc.ABC):
             differ between runs by nature and are left out of same-seed checks.
         curve_prefix: where an evaluation's ``history`` curves go in MLflow (``train/``: the chart
             section "train", ``train/mean_return`` beside the final ``mean_return``).
-        ignores_groups: the optional groups (``action``, ``reward``, ``curriculum``) this task
-            never reads; choosing one of them for it is refused at composition, in one line,
-            instead of being silently ignored. Empty by default (a task may read any group).
+        ignores_groups: the groups this task never reads; choosing one of them for it is
+            refused at composition, in one line, instead of being silently ignored: an optional
+            group (``action``, ``reward``, ``curriculum``) whenever the composed config has it, a
+            group with a default (``sim``, ``spd``, ``character``, ``agent``) when the command line
+            chooses it or sets one of its keys. Empty by default (a task may read any group).
         record_keys: the keys of the records its reward terms are given (None: not declared, not
             checked). With it, composition refuses a ``reward`` term that reads a key the records
             do not have (``RewardTerm.needs``), in one line, before a run opens.
