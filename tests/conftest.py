@@ -65,6 +65,20 @@ def run_jt(*args: str, extra_path: Path | None = None, cwd: Path | None = None,
                           env=jt_env(extra_path), cwd=cwd, timeout=timeout)
 
 
+def store_query(store: Path, sql: str, *params: object) -> list[tuple]:
+    """Rows of ``sql`` on a store's ``mlflow.db`` read directly (what a run left behind, even while
+    it runs); ``[]`` while a writer holds the lock or before the tables exist."""
+    import sqlite3
+
+    con = sqlite3.connect(Path(store) / "mlflow.db", timeout=30)
+    try:
+        return con.execute(sql, params).fetchall()
+    except sqlite3.OperationalError:  # locked by a writer, or a table not there yet
+        return []
+    finally:
+        con.close()
+
+
 @pytest.fixture()
 def one_torch_thread():
     """One torch thread for a learner with small nets on 2 shared cores (restored afterwards)."""

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import jt_env
+from tests.conftest import jt_env, store_query
 
 SEED = 7
 COMMON = ["task=quadratic", "search=random", "search.batch=2", "executor.workers=1", f"seed={SEED}"]
@@ -63,14 +63,7 @@ def _jt(plugin_dir: Path, *args: str) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def _query(store: Path, sql: str, *params: object) -> list[tuple]:
-    con = sqlite3.connect(store / "mlflow.db", timeout=30)
-    try:
-        return con.execute(sql, params).fetchall()
-    except sqlite3.OperationalError:  # locked by a writer, or a table not there yet
-        return []
-    finally:
-        con.close()
+_query = store_query
 
 
 def _outer_ids(store: Path) -> list[str]:

@@ -5,25 +5,17 @@ ends with exactly the metrics of an uninterrupted run of the same seed."""
 from __future__ import annotations
 
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-from tests.conftest import jt_env, run_jt
+from tests.conftest import jt_env, run_jt, store_query
 
 COMMON = ("run", "task=runup", "experiment=smoke", "seed=0")
 
 
-def _query(store: Path, sql: str, *params: object) -> list[tuple]:
-    con = sqlite3.connect(store / "mlflow.db", timeout=30)
-    try:
-        return con.execute(sql, params).fetchall()
-    except sqlite3.OperationalError:  # locked by a writer, or a table not there yet
-        return []
-    finally:
-        con.close()
+_query = store_query
 
 
 def _outer(store: Path) -> tuple[str, str]:
