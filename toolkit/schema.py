@@ -257,6 +257,11 @@ def _common_keys(where: str, cls: type, schema: type, node: Any,
 OPTIONAL_GROUPS = ("action", "reward", "curriculum")
 
 
+def _never_read(task: str, group: str, drop: str) -> JtError:
+    article = "an" if group[0] in "aeiou" else "a"
+    return JtError(f"task={task} does not read {article} {group} group; drop {drop} (it would be ignored)")
+
+
 def ignored_choice(task: str, key: str, value: Any) -> None:
     """A command-line ``key=value`` (a group choice or ``group.field=...``) for a group with a
     default that ``task`` never reads (``Task.ignores_groups``): one ``JtError`` line."""
@@ -264,8 +269,7 @@ def ignored_choice(task: str, key: str, value: Any) -> None:
     if group in OPTIONAL_GROUPS or task not in plugins.names("task"):
         return
     if group in getattr(plugins.load("task", task), "ignores_groups", ()):
-        article = "an" if group[0] in "aeiou" else "a"
-        raise JtError(f"task={task} does not read {article} {group} group; drop {key}={value} (it would be ignored)")
+        raise _never_read(task, group, f"{key}={value}")
 
 
 def run_checks(cfg: Any) -> None:
@@ -278,9 +282,7 @@ def run_checks(cfg: Any) -> None:
         if chosen:
             g = chosen[0]
             what = cfg[g].get("name", "") if hasattr(cfg[g], "get") else ""
-            article = "an" if g[0] in "aeiou" else "a"
-            drop = f"{g}={what}" if what else f"the {g}= choice"
-            raise JtError(f"task={task['name']} does not read {article} {g} group; drop {drop} (it would be ignored)")
+            raise _never_read(str(task["name"]), g, f"{g}={what}" if what else f"the {g}= choice")
     if task is not None and "name" in task:
         check_declared_needs(cfg, plugins.load("task", str(task["name"])))
     for group in plugins.KINDS:
