@@ -7,6 +7,9 @@ start, and how far the clips themselves get without feedback.
 ended, the highest neck height, whether it got up; then the same for the open-loop clip (every PD
 target the clip's pose at that time, no policy: ``open_loop_clip``); and, with ``--out``, plots the
 run's per-iteration history and its evaluations from perturbed clip starts against samples.
+``--stand SECONDS`` measures standing balance instead: the deterministic policy from every curve's
+standing start, given ``SECONDS`` of standing (``task.t_stand``, no start noise), control steps
+until the episode ends (``standing_balance``).
 """
 
 from __future__ import annotations
@@ -78,6 +81,20 @@ def policy_starts(env: Any, model: Any, curves: tuple[str, ...] = ("facedown", "
     return rows
 
 
+def standing_balance(env: Any, model: Any, seconds: float) -> list[dict[str, Any]]:
+    """``episode`` from every curve's standing start with ``seconds`` s of standing (the env's
+    ``t_stand`` set for it, restored after): how long the policy balances beyond its training
+    episodes (``T_stand`` = 3 s, 003 §5.6). Rows carry ``curve``, ``steps`` and ``of`` (the limit)."""
+    old = env.spec_.t_stand
+    env.spec_.t_stand = float(seconds)
+    try:
+        limit = int(round(float(seconds) * env.control_hz))
+        return [{"curve": c.name, "of": limit, **episode(env, model, {"kind": "standing", "curve": c.name})}
+                for c in env.curves]
+    finally:
+        env.spec_.t_stand = old
+
+
 def plot_history(ppo_h5: Path, out: Path) -> Optional[Path]:
     """``getup_history.png``: the training return rate and the share ended early per iteration, and
     the evaluations' success / got-up shares from perturbed clip starts, against samples."""
@@ -123,6 +140,8 @@ def main(argv: Optional[list[str]] = None) -> None:
     ap.add_argument("--store", default=None, help="the store the run is in")
     ap.add_argument("--out", default=None, help="a folder for getup_history.png")
     ap.add_argument("--config", default=None, help="the run's config.yaml (default: the one beside its ppo.h5)")
+    ap.add_argument("--stand", type=float, default=None, metavar="SECONDS",
+                    help="standing balance only: standing starts given SECONDS of standing")
     args = ap.parse_args(argv)
     from toolkit.errors import JtError
 
@@ -140,6 +159,10 @@ def main(argv: Optional[list[str]] = None) -> None:
     env = task.make_env(None, seed=0)
     try:
         model = load_policy(ref.path)
+        if args.stand is not None:
+            for r in standing_balance(env, model, args.stand):
+                print(f"standing {r['curve']:16s} {r['steps']:4d} of {r['of']} steps  ({r['reason']})")
+            return
         for r in policy_starts(env, model):
             print(f"policy   {r['curve']:9s} {r['start']:12s} {r['steps']:4d} steps  h_max {r['h_max']:.2f} m  "
                   f"got_up {r['got_up']:.0f}  success {r['success']:.0f}  ({r['reason']})")

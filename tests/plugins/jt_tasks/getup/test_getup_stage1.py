@@ -134,3 +134,19 @@ def test_the_clip_tracked_without_feedback_does_not_get_up():
 
     o = open_loop_clip("getup_facedown", sim_groups(), t_stand=1.0)
     assert 0.3 < o["h_max"] < 0.8 * 1.35 and o["h_end"] < 0.3 and o["duration"] == pytest.approx(3.03, abs=0.01)
+
+
+def test_standing_balance_gives_each_curve_its_standing_start_and_restores_t_stand():
+    """``study --stand``: a policy that holds the rest pose (raw zero action, no feedback) falls from
+    every standing start well before 4 s (a PD-held pose falls in ~2 s, docs/getup.md), and the
+    measurement leaves the env's 3 s standing phase as it found it."""
+    from jt_tasks.getup.study import standing_balance
+
+    e = make_task("task.curves=[facedown,faceup]", "task.p_standing=1", "task.p_fallen=0").make_env(None, seed=0)
+    try:
+        rows = standing_balance(e, _Still(e.action_space.shape[0]), 4.0)
+        assert e.spec_.t_stand == 3.0
+    finally:
+        e.close()
+    assert [r["curve"] for r in rows] == ["facedown", "faceup"] and all(r["of"] == 120 for r in rows)
+    assert all(10 < r["steps"] < 120 and r["reason"] != "time limit" for r in rows)
