@@ -15,8 +15,9 @@ until the episode ends (``standing_balance``).
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, NoReturn, Optional
 
 import numpy as np
 
@@ -129,6 +130,14 @@ def plot_history(ppo_h5: Path, out: Path) -> Optional[Path]:
     return path
 
 
+def _fail(message: str) -> NoReturn:
+    """A user's mistake: one line on stderr, exit status 2."""
+    import sys
+
+    print(f"study: {message}", file=sys.stderr)
+    raise SystemExit(2)
+
+
 def main(argv: Optional[list[str]] = None) -> None:
     from toolkit import plugins
     from toolkit.config import validate
@@ -143,18 +152,22 @@ def main(argv: Optional[list[str]] = None) -> None:
     ap.add_argument("--stand", type=float, default=None, metavar="SECONDS",
                     help="standing balance only: standing starts given SECONDS of standing")
     args = ap.parse_args(argv)
+    if args.stand is not None and not (math.isfinite(args.stand) and args.stand > 0):
+        _fail(f"--stand={args.stand}: the seconds of standing must be a finite number > 0 (e.g. --stand 10)")
     from toolkit.errors import JtError
 
     try:
         ref = resolve(args.run, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
     except JtError as e:
-        raise SystemExit(f"study: {e}") from None
+        _fail(str(e))
     from omegaconf import OmegaConf
 
     found = [Path(args.config)] if args.config else \
         [p / "config.yaml" for p in Path(ref.path).parents[:2] if (p / "config.yaml").exists()]
+    if args.config and not found[0].is_file():
+        _fail(f"--config={args.config}: no such file")
     if not found:
-        raise SystemExit(f"study: no config.yaml beside {ref.path} (the run's work folder)")
+        _fail(f"no config.yaml beside {ref.path} (the run's work folder); pass --config")
     task = plugins.load("task", "getup")(validate(OmegaConf.load(found[0])))
     env = task.make_env(None, seed=0)
     try:

@@ -150,3 +150,17 @@ def test_standing_balance_gives_each_curve_its_standing_start_and_restores_t_sta
         e.close()
     assert [r["curve"] for r in rows] == ["facedown", "faceup"] and all(r["of"] == 120 for r in rows)
     assert all(10 < r["steps"] < 120 and r["reason"] != "time limit" for r in rows)
+
+
+@pytest.mark.parametrize("argv,match", [
+    (["RUN", "--stand", "0"], "--stand=0.0: the seconds of standing must be a finite number > 0"),
+    (["RUN", "--stand", "nan"], "--stand=nan"),
+    (["/no/such/ppo.h5", "--stand", "10"], "no such file"),
+])
+def test_study_refuses_a_bad_value_in_one_line_with_exit_2(argv, match, capsys):
+    from jt_tasks.getup.study import main
+
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and match in err and len(err.strip().splitlines()) == 1
