@@ -42,6 +42,14 @@ class GetupConfig(PolicyConfig):
     """Share of episodes starting from a rag-doll state (003 §5.2; the share is ours); the rest start at the curve's clip's first pose (003 §5.5)."""
     rsi: float = 0.0
     """Share of clip starts that begin at a uniformly random time of the clip instead of its first pose, the curve's clock set to that time (reference state initialisation, Peng et al. 2018; ours, not 003: experiment=laptop, docs/getup.md)."""
+    rsi_from: float = 0.0
+    """Fraction of the clip where starts inside it (``rsi``) begin: drawn in [rsi_from · T, T] (ours; 0: the whole clip); with ``rsi_step`` > 0 the front of a reverse curriculum (``jt_tasks.getup.reverse``, docs/getup.md)."""
+    rsi_step: float = 0.0
+    """How far the front moves back each time the newest band of starts, [rsi_from, rsi_from + rsi_step) of the clip, succeeds (ours; 0: a fixed window)."""
+    rsi_success: float = 0.5
+    """Success share of the band's last ``rsi_episodes`` training episodes that moves the front (ours)."""
+    rsi_episodes: int = 32
+    """Training episodes from the band that share is measured over (ours)."""
     start_noise: float = 0.0
     """Rad, joint perturbation (``initial.perturb_joints``) of every training clip start (ours; 0 = the clip's pose as 003 §5.5)."""
     n_fallen: int = 8
@@ -137,6 +145,15 @@ class GetupConfig(PolicyConfig):
         require(self.eval_episodes >= 1, "task.eval_episodes", self.eval_episodes, "must be >= 1")
         require(self.n_fallen >= 0, "task.n_fallen", self.n_fallen, "must be >= 0")
         require(finite(self.rsi) and 0.0 <= self.rsi <= 1.0, "task.rsi", self.rsi, "must be in [0, 1]")
+        require(finite(self.rsi_from) and 0.0 <= self.rsi_from < 1.0, "task.rsi_from", self.rsi_from,
+                "must be a fraction of the clip in [0, 1)")
+        require(finite(self.rsi_step) and 0.0 <= self.rsi_step <= 1.0, "task.rsi_step", self.rsi_step, "must be in [0, 1]")
+        require(finite(self.rsi_success) and 0.0 < self.rsi_success <= 1.0, "task.rsi_success", self.rsi_success,
+                "must be in (0, 1]")
+        require(isinstance(self.rsi_episodes, int) and self.rsi_episodes >= 1, "task.rsi_episodes",
+                self.rsi_episodes, "must be an integer >= 1")
+        require(self.rsi > 0.0 or not (self.rsi_from or self.rsi_step), "task.rsi", self.rsi,
+                "task.rsi_from / task.rsi_step shape the starts inside the clip: they need task.rsi > 0")
         for key in ("start_noise", "eval_start_noise"):
             v = getattr(self, key)
             require(finite(v) and 0.0 <= v <= 1.0, f"task.{key}", v, "must be a finite number in [0, 1] rad")

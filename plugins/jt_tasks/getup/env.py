@@ -60,6 +60,7 @@ class GetupSpec:
     p_standing: float = default_of(_C, "p_standing")
     p_fallen: float = default_of(_C, "p_fallen")
     rsi: float = default_of(_C, "rsi")
+    rsi_from: float = default_of(_C, "rsi_from")
     start_noise: float = default_of(_C, "start_noise")
     curve_match_deg: float = default_of(_C, "curve_match_deg")
     r_task_min: float = default_of(_C, "r_task_min")
@@ -127,6 +128,7 @@ class GetupEnv(CharacterEnv):
         self._joints = joint_layout()
         self._clip_starts: dict[tuple, tuple] = {}
         self.terrain_level = 0  # highest unlocked region, set by the terrain curriculum (003 §5.4)
+        self.rsi_from = float(spec.rsi_from)  # starts inside the clip from this fraction of it on (reverse.py)
         self.region = 0  # the episode's region
         self.tspec = TerrainSpec.from_dict(spec.terrain) if spec.terrain else None
         self.ground_bodies = {int(self.sim.ground)}
@@ -248,7 +250,8 @@ class GetupEnv(CharacterEnv):
         if kind == "clip":  # no draw at the defaults (rsi = start_noise = 0): the same episodes as before
             at = float(opts.get("at", 0.0) or 0.0)
             if "at" not in opts and spec.rsi > 0.0 and float(rng.random()) < spec.rsi:
-                at = float(rng.uniform(0.0, self.curves[int(curve)].duration))
+                duration = self.curves[int(curve)].duration
+                at = float(rng.uniform(float(self.rsi_from) * duration, duration))
             noise = float(opts.get("noise", spec.start_noise) or 0.0)
             if noise > 0.0:
                 seed = opts.get("noise_seed")
@@ -397,6 +400,7 @@ class GetupEnv(CharacterEnv):
                                 "time_to_rise": float(self.rise_t) if not standing else math.nan}
         if self.start_time > 0.0:  # a clip start inside the clip (rsi): not a get-up from the ground
             info["start_time"] = float(self.start_time)
+            info["start_frac"] = float(self.start_time / self.curve.duration)  # reverse.StartWindow reads it
         if self.log:
             for k in self.log[0]:
                 if k.startswith("r"):

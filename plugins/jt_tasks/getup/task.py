@@ -162,9 +162,15 @@ class GetupTask(PolicyTask):
                                 ("success", ".2f", "— (no episode from the ground ended yet)"),
                                 cur.on_iteration if cur is not None else None)
         p = self.params
+        then: Any = hist.on_iteration
+        if p.rsi > 0.0 and (p.rsi_from > 0.0 or p.rsi_step > 0.0):  # the reverse curriculum (reverse.py)
+            from jt_tasks.getup.reverse import StartWindow
+
+            then = StartWindow(p.rsi_from, p.rsi_step, p.rsi_success, p.rsi_episodes, extra, then)
         hook = ClipStartTraining(functools.partial(self.env_class, spec, seed=ctx.seed), p.eval_clip_during,
-                                 p.eval_start_noise, p.eval_every, extra, hist.on_iteration, ctx.progress, total)
-        return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook, "history": hist})
+                                 p.eval_start_noise, p.eval_every, extra, then, ctx.progress, total)
+        return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook, "history": hist,
+                                                            "window": then if then is not hist.on_iteration else None})
 
     def final_options(self, env: Any) -> Optional[dict]:
         return {"kind": "clip", "curve": self.params.eval_curve}
@@ -252,6 +258,12 @@ class GetupTask(PolicyTask):
             history["eval_success_clip"] = [(int(r[0]), float(r[1])) for r in rows]
             history["eval_got_up_clip"] = [(int(r[0]), float(r[2])) for r in rows]
             metrics["best_success_clip_during"] = float(rows[:, 1].max())
+        if hooks.state.get("window") is not None:  # the reverse curriculum's front over training
+            from jt_tasks.getup.reverse import KEY, MOVES_KEY
+
+            moves = np.asarray(res.extra.get(MOVES_KEY, np.zeros((0, 2))), float).reshape(-1, 2)
+            history["rsi_from"] = [(0, float(self.params.rsi_from))] + [(int(s), float(f)) for s, f in moves]
+            metrics["rsi_from_final"] = float(np.asarray(res.extra.get(KEY, [self.params.rsi_from]), float).reshape(-1)[0])
         return Evaluation(metrics=metrics, history=history)
 
     def extra_artifacts(self, workdir: Path) -> list[str]:
