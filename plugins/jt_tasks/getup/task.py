@@ -162,15 +162,16 @@ class GetupTask(PolicyTask):
                                 ("success", ".2f", "— (no episode from the ground ended yet)"),
                                 cur.on_iteration if cur is not None else None)
         p = self.params
-        then: Any = hist.on_iteration
+        window = None
         if p.rsi > 0.0 and (p.rsi_from > 0.0 or p.rsi_step > 0.0):  # the reverse curriculum (reverse.py)
             from jt_tasks.getup.reverse import StartWindow
 
-            then = StartWindow(p.rsi_from, p.rsi_step, p.rsi_success, p.rsi_episodes, extra, then)
+            window = StartWindow(p.rsi_from, p.rsi_step, p.rsi_success, p.rsi_episodes, extra, hist.on_iteration)
         hook = ClipStartTraining(functools.partial(self.env_class, spec, seed=ctx.seed), p.eval_clip_during,
-                                 p.eval_start_noise, p.eval_every, extra, then, ctx.progress, total)
+                                 p.eval_start_noise, p.eval_every, extra, window or hist.on_iteration, ctx.progress,
+                                 total)
         return Hooks(on_iteration=hook, extra=extra, state={"cur": cur, "training": hook, "history": hist,
-                                                            "window": then if then is not hist.on_iteration else None})
+                                                            "window": window})
 
     def final_options(self, env: Any) -> Optional[dict]:
         return {"kind": "clip", "curve": self.params.eval_curve}
