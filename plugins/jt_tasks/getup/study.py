@@ -70,13 +70,17 @@ def episode(env: Any, model: Any, options: dict) -> dict[str, Any]:
             "got_up": float(info.get("got_up", 0.0)), "success": float(info.get("success", 0.0))}
 
 
-def policy_starts(env: Any, model: Any, curves: tuple[str, ...] = ("facedown", "faceup")) -> list[dict[str, Any]]:
-    """``episode`` from each clip start of ``FRACTIONS`` and from standing, for each curve."""
+def policy_starts(env: Any, model: Any, curves: tuple[str, ...] = ("facedown", "faceup"),
+                  fractions: tuple[float, ...] = FRACTIONS) -> list[dict[str, Any]]:
+    """``episode`` from each clip start at ``fractions`` of the clip and from standing, for each
+    curve; a row's ``needs`` is the control steps a success lasts from there (the rest of the clip
+    and ``t_stand``)."""
     rows = []
     for name in curves:
         T = next(c for c in env.curves if c.name == name).duration
-        for frac in FRACTIONS:
-            rows.append({"curve": name, "start": f"clip at {frac:.0%}",
+        for frac in fractions:
+            needs = int(round(((1.0 - frac) * T + env.spec_.t_stand) * env.control_hz))
+            rows.append({"curve": name, "start": f"clip at {frac:.0%}", "needs": needs,
                          **episode(env, model, {"kind": "clip", "curve": name, "at": frac * T})})
         rows.append({"curve": name, "start": "standing", **episode(env, model, {"kind": "standing", "curve": name})})
     return rows
@@ -151,9 +155,14 @@ def main(argv: Optional[list[str]] = None) -> None:
     ap.add_argument("--config", default=None, help="the run's config.yaml (default: the one beside its ppo.h5)")
     ap.add_argument("--stand", type=float, default=None, metavar="SECONDS",
                     help="standing balance only: standing starts given SECONDS of standing")
+    ap.add_argument("--at", type=float, nargs="+", default=list(FRACTIONS), metavar="FRACTION",
+                    help="clip starts at these fractions of the clip, in [0, 1) (default: 0 0.25 0.5 0.75 0.9)")
     args = ap.parse_args(argv)
     if args.stand is not None and not (math.isfinite(args.stand) and args.stand > 0):
         _fail(f"--stand={args.stand}: the seconds of standing must be a finite number > 0 (e.g. --stand 10)")
+    bad = [a for a in args.at if not (math.isfinite(a) and 0.0 <= a < 1.0)]
+    if bad:
+        _fail(f"--at={bad[0]}: a clip start is a fraction of the clip in [0, 1) (e.g. --at 0.5 0.75)")
     from toolkit.errors import JtError
 
     try:
@@ -176,8 +185,9 @@ def main(argv: Optional[list[str]] = None) -> None:
             for r in standing_balance(env, model, args.stand):
                 print(f"standing {r['curve']:16s} {r['steps']:4d} of {r['of']} steps  ({r['reason']})")
             return
-        for r in policy_starts(env, model):
-            print(f"policy   {r['curve']:9s} {r['start']:12s} {r['steps']:4d} steps  h_max {r['h_max']:.2f} m  "
+        for r in policy_starts(env, model, fractions=tuple(args.at)):
+            of = f" of {r['needs']}" if "needs" in r else ""
+            print(f"policy   {r['curve']:9s} {r['start']:12s} {r['steps']:4d}{of} steps  h_max {r['h_max']:.2f} m  "
                   f"got_up {r['got_up']:.0f}  success {r['success']:.0f}  ({r['reason']})")
         sim_groups = env.spec_.sim
     finally:

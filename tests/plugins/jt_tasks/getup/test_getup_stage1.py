@@ -160,6 +160,7 @@ def test_standing_balance_gives_each_curve_its_standing_start_and_restores_t_sta
     (["RUN", "--stand", "0"], "--stand=0.0: the seconds of standing must be a finite number > 0"),
     (["RUN", "--stand", "nan"], "--stand=nan"),
     (["/no/such/ppo.h5", "--stand", "10"], "no such file"),
+    (["RUN", "--at", "0.5", "1.0"], "--at=1.0: a clip start is a fraction of the clip in [0, 1)"),
 ])
 def test_study_refuses_a_bad_value_in_one_line_with_exit_2(argv, match, capsys):
     from jt_tasks.getup.study import main
@@ -168,3 +169,17 @@ def test_study_refuses_a_bad_value_in_one_line_with_exit_2(argv, match, capsys):
         main(argv)
     err = capsys.readouterr().err
     assert e.value.code == 2 and match in err and len(err.strip().splitlines()) == 1
+
+
+def test_policy_starts_at_chosen_fractions_say_what_a_success_needs():
+    """``study --at``: episodes from the clip at the given fractions, each with the control steps a
+    success lasts from there; the rest-pose policy lasts fewer than that from every one."""
+    from jt_tasks.getup.study import policy_starts
+
+    e = make_task("task.curves=[facedown,faceup]").make_env(None, seed=0)
+    try:
+        rows = policy_starts(e, _Still(e.action_space.shape[0]), curves=("facedown",), fractions=(0.8,))
+    finally:
+        e.close()
+    assert [r["start"] for r in rows] == ["clip at 80%", "standing"]
+    assert rows[0]["needs"] == round((0.2 * e.curves[0].duration + 3.0) * 30) and rows[0]["steps"] < rows[0]["needs"]
