@@ -36,6 +36,8 @@ class GetupConfig(PolicyConfig):
     """Clamped end knots, uniform inside (ours, jt's splines: the curve starts and ends at its end points); false: unclamped cardinal."""
     t_stand: float = 3.0
     """S of standing after T in every episode (003 §5.6: T_stand = 3 s)."""
+    stand_pose: str = "clip"
+    """The standing starts' pose and eq 9's neutral pose q̂: clip (the facedown clip's final frame, a standing pose from a reference clip as 003 §5.2) or symmetric (ours: that frame with the right leg the mirror image of the left and both soles flat on the ground; held by PD the clip's frame falls in 1.2 s and no sagittal ankle feedback keeps it up, the symmetric one stands with it: docs/getup.md)."""
     p_standing: float = 0.1
     """Share of episodes starting standing (003 §5.2 "necessary"; the share is ours)."""
     p_fallen: float = 0.3
@@ -120,7 +122,7 @@ class GetupConfig(PolicyConfig):
         from toolkit.schema import finite, require
 
         from jt_tasks.getup.curves import build_curves
-        from jt_tasks.getup.initial import STYLES
+        from jt_tasks.getup.initial import STAND_POSES, STYLES
 
         require(self.n_control >= 4, "task.n_control", self.n_control, "a cubic B-spline needs >= 4 control points")
         require(self.extraction in ("sample", "lstsq"), "task.extraction", self.extraction, "sample or lstsq")
@@ -144,6 +146,7 @@ class GetupConfig(PolicyConfig):
                 f"must be one of task.curves ({', '.join(self.curves)})")
         require(self.eval_episodes >= 1, "task.eval_episodes", self.eval_episodes, "must be >= 1")
         require(self.n_fallen >= 0, "task.n_fallen", self.n_fallen, "must be >= 0")
+        require(self.stand_pose in STAND_POSES, "task.stand_pose", self.stand_pose, f"one of {', '.join(STAND_POSES)}")
         require(finite(self.rsi) and 0.0 <= self.rsi <= 1.0, "task.rsi", self.rsi, "must be in [0, 1]")
         require(finite(self.rsi_from) and 0.0 <= self.rsi_from < 1.0, "task.rsi_from", self.rsi_from,
                 "must be a fraction of the clip in [0, 1)")

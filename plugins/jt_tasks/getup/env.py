@@ -35,7 +35,7 @@ from jt_tasks.getup.config import GetupConfig as _C
 from jt_tasks.getup import kernels
 from jt_tasks.getup.curves import FeatureCurve
 from jt_tasks.getup.ground import lift_to_ground
-from jt_tasks.getup.initial import clip_pose, clip_state_at, perturb_joints, pick_curve
+from jt_tasks.getup.initial import clip_pose, clip_state_at, perturb_joints, pick_curve, symmetric_legs
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
 from toolkit.policy.env import CharacterEnv
 from toolkit.policy.spec import default_of
@@ -58,6 +58,7 @@ class GetupSpec:
     natural_terms: list = default_of(_C, "natural_terms")
     t_stand: float = default_of(_C, "t_stand")
     p_standing: float = default_of(_C, "p_standing")
+    stand_pose: str = default_of(_C, "stand_pose")
     p_fallen: float = default_of(_C, "p_fallen")
     rsi: float = default_of(_C, "rsi")
     rsi_from: float = default_of(_C, "rsi_from")
@@ -123,8 +124,11 @@ class GetupEnv(CharacterEnv):
         self.terms = self.load_terms((spec.reward or {}).get("terms"))
         self.natural = set(spec.natural_terms)
         q_stand, qd_stand = clip_pose("getup_facedown", False, frame=-1)
+        if spec.stand_pose == "symmetric":  # the right leg mirrors the left, soles flat (ours)
+            self.sim.reset(symmetric_legs(q_stand), np.zeros_like(qd_stand))
+            q_stand = lift_to_ground(orient_feet(self.sim, symmetric_legs(q_stand), np.zeros_like(qd_stand)))
         self.stand_state = (q_stand, np.zeros_like(qd_stand))
-        self.neutral = joint_rotations(q_stand)  # q̂ of eq 9: the clip's final standing pose (ours)
+        self.neutral = joint_rotations(q_stand)  # q̂ of eq 9: the standing pose (task.stand_pose)
         self._joints = joint_layout()
         self._clip_starts: dict[tuple, tuple] = {}
         self.terrain_level = 0  # highest unlocked region, set by the terrain curriculum (003 §5.4)

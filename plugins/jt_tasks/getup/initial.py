@@ -9,6 +9,7 @@
   with a random heading and random joint perturbations, released above the ground with the PD
   servos off (kp = 0, a small joint damping), simulated until at rest (every generalised speed
   below ``rest_speed``) and accepted then; a drop not at rest within ``settle_max`` s is redrawn.
+* ``symmetric_legs``: a stance with one leg the mirror image of the other (``task.stand_pose``).
 * ``pick_curve``: a curve whose starting torso angles are within 30° of a state's (§5.2), else
   the nearest one.
 """
@@ -25,6 +26,7 @@ from toolkit.motion import rotations as rot
 from jt_tasks.getup.ground import lift_to_ground
 
 STYLES = ("prone", "supine")  #: the rag-doll drop postures (003 §5.2)
+STAND_POSES = ("clip", "symmetric")  #: ``task.stand_pose``: the standing pose (``symmetric_legs``)
 
 
 def clip_pose(clip: str, mirrored: bool = False, frame: int = 0, ground: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -39,6 +41,20 @@ def clip_pose(clip: str, mirrored: bool = False, frame: int = 0, ground: float =
     p, r, j, v, w, jv = reference_state(c, t)
     q = lift_to_ground(np.concatenate([p, r, j]), ground)
     return q, np.concatenate([v, w, jv])
+
+
+def symmetric_legs(q: np.ndarray, source: str = "left") -> np.ndarray:
+    """``q`` ``(n_q,)`` with the other leg's hip, knee and ankle the mirror image (across the
+    character's sagittal plane) of the ``source`` leg's: a stance with both feet alike."""
+    from toolkit.motion.skeletons import HUMANOID
+
+    q = np.array(q, dtype=np.float64)
+    mirrored = HUMANOID.mirror_joints(q[7:])
+    other = "right" if source == "left" else "left"
+    for part in ("hip", "knee", "ankle"):
+        s = HUMANOID.q_slices[f"{other}_{part}"]
+        q[7 + s.start:7 + s.stop] = mirrored[s]
+    return q
 
 
 def clip_state_at(clip: str, mirrored: bool, t: float, duration: Optional[float] = None,

@@ -121,7 +121,7 @@ def test_an_untrained_policy_does_not_get_up_from_clip_starts():
     # the reverse curriculum over starts inside the clip (test_getup_reverse.py)
     ("task.rsi=0.5 task.rsi_from=1.0", "task.rsi_from"), ("task.rsi=0.5 task.rsi_step=-0.1", "task.rsi_step"),
     ("task.rsi=0.5 task.rsi_success=0", "task.rsi_success"), ("task.rsi=0.5 task.rsi_episodes=0", "task.rsi_episodes"),
-    ("task.rsi_from=0.5", "need task.rsi > 0"),
+    ("task.rsi_from=0.5", "need task.rsi > 0"), ("task.stand_pose=tpose", "task.stand_pose"),
 ])
 def test_bad_values_are_one_line(override, match):
     with pytest.raises(JtError, match=match):
