@@ -67,6 +67,7 @@ class SpacetimeSpec:
     loop: Optional[bool] = default_of(_C, "loop")
     ground_clearance: float = default_of(_C, "ground_clearance")
     cycle_turn: bool = default_of(_C, "cycle_turn")
+    straighten: bool = default_of(_C, "straighten")
     root_orientation: str = default_of(_C, "root_orientation")
     velocities: str = default_of(_C, "velocities")
     ffc_lead: float = default_of(_C, "ffc_lead")
@@ -98,7 +99,7 @@ class SpacetimeEnv(CharacterEnv):
 
         spec = self.spec_
         self.axis = clips.heading_axis(spec.clip, spec.heading_axis)
-        self.ref = SpacetimeReference(spec.clip, self.axis, spec.loop, spec.cycle_turn)
+        self.ref = SpacetimeReference(spec.clip, self.axis, spec.loop, spec.cycle_turn, spec.straighten)
         self.ee_links = end_effector_links(self.sim)  # resolved once: the bounds read them every step
         # allowed contacts by the skeleton's link order: the simulator's link indices on the humanoid
         # (tests/plugins/jt_tasks/test_link_names.py)

@@ -18,6 +18,11 @@ answers, at any clip time ``t`` (``sample``) or phase (``at_phase``):
   (the walk turns 0.12 rad per cycle, the run 0.09). Without it (the authors' code), each cycle
   is shifted by ``Clip.cycle_offset()`` only and the heading snaps back at every seam. A
   non-looping clip holds its last frame (zero velocities) after its end.
+* ``straighten`` removes a looping clip's heading drift before any of this: the root's yaw about +y
+  minus a ramp linear in clip time from 0 to the cycle's turn, so the last frame faces as the
+  first and cycles neither turn nor snap (the walk's root turns 0.12 rad over a cycle while its
+  root positions go straight along x: the body faces up to 0.12 rad off the way it walks; the
+  authors' walk file has the root's rotation removed altogether).
 
 The heading frame turns about +y (y-up world): ``heading_axis`` x (the humanoid's forward axis)
 or z (backflip, roll, crawl: x points up or down during the motion; authors' code).
@@ -117,6 +122,23 @@ def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x",
     return rot.quat_rotate(inv, pts)
 
 
+def clip_turn(clip: Any, axis: str = "x") -> float:
+    """Rad, the heading change about +y from a clip's first frame to its last (in ``(-pi, pi]``)."""
+    yaw = [2.0 * math.atan2(heading_quat(clip.root_rot[i], axis)[1], heading_quat(clip.root_rot[i], axis)[3])
+           for i in (0, -1)]
+    return float(math.remainder(yaw[1] - yaw[0], 2.0 * math.pi))
+
+
+def straightened(clip: Any, axis: str = "x") -> Any:
+    """``clip`` with its heading drift removed: frame ``i``'s root rotation turned about +y by
+    ``-turn (t_i - t_0) / T`` (``turn = clip_turn``), positions and joints unchanged."""
+    turn = clip_turn(clip, axis)
+    t = np.asarray(clip.times, dtype=float)
+    a = -turn * (t - t[0]) / (t[-1] - t[0])
+    yaw = np.stack([np.zeros_like(a), np.sin(0.5 * a), np.zeros_like(a), np.cos(0.5 * a)], axis=1)
+    return dataclasses.replace(clip, root_rot=rot.quat_multiply(yaw, np.asarray(clip.root_rot, dtype=float)))
+
+
 @dataclasses.dataclass(frozen=True)
 class RefState:
     """The reference at one clip time.
@@ -142,6 +164,7 @@ class SpacetimeReference:
         heading_axis: ``x`` or ``z``.
         loop: override the clip's own ``Loop`` flag (None: keep it; every shipped clip wraps).
         cycle_turn: carry the clip's heading change per cycle into the next cycles (module docstring).
+        straighten: remove a looping clip's heading drift over the cycle first (module docstring).
 
     Attributes:
         turn: rad, the heading change over one cycle (last frame minus first; 0 for a non-looping
@@ -150,7 +173,7 @@ class SpacetimeReference:
     """
 
     def __init__(self, clip: str = "run", heading_axis: str = "x", loop: Optional[bool] = None,
-                 cycle_turn: bool = True) -> None:
+                 cycle_turn: bool = True, straighten: bool = False) -> None:
         from toolkit.errors import JtError
         from toolkit.motion.kinematics import clip_velocities, forward_kinematics, kinematic_body
 
@@ -160,6 +183,8 @@ class SpacetimeReference:
         if loop is not None:
             self.clip = dataclasses.replace(self.clip, loop=bool(loop))
         self.heading_axis = heading_axis
+        if straighten and self.clip.loop:
+            self.clip = straightened(self.clip, heading_axis)
         c = self.clip
         self.skeleton = c.skeleton
         self.loop = bool(c.loop)
@@ -184,9 +209,7 @@ class SpacetimeReference:
         self._times = [float(x) for x in c.times]
         self.turn = 0.0
         if self.loop and cycle_turn:
-            yaw = [2.0 * math.atan2(heading_quat(c.root_rot[i], heading_axis)[1],
-                                    heading_quat(c.root_rot[i], heading_axis)[3]) for i in (0, -1)]
-            self.turn = float(math.remainder(yaw[1] - yaw[0], 2.0 * math.pi))
+            self.turn = clip_turn(c, heading_axis)
         self._p0 = np.array([c.root_pos[0, 0], 0.0, c.root_pos[0, 2]])
         self._cycles: dict[int, np.ndarray] = {0: self._p0.copy()}
         if self.turn != 0.0:
