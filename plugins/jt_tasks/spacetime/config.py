@@ -50,7 +50,7 @@ class SpacetimeConfig(PolicyConfig):
     cycle_turn: bool = True
     """A looping clip's next cycle carries on its heading change (the walk turns 0.12 rad per cycle), so the reference is where a character tracking the clip goes (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam)."""
     straighten: bool = False
-    """Remove a looping clip's heading drift: the root's yaw minus a ramp over the cycle, so the clip ends facing as it starts and cycles do not turn (ours; the walk's root turns 0.12 rad per cycle while its positions go straight; the authors' walk file has no root rotation at all; 002 and DeepMimic's file: the clip as recorded)."""
+    """Remove the root's yaw from every frame of a looping clip (each frame faces as the first; pitch, roll, positions, joints kept), so the clip faces the way it travels and cycles do not turn (ours; the shipped walk's root yaw jumps 0.125 rad mid-cycle and ends 0.12 rad from its start while its path goes straight; the authors' walk file has no root rotation at all; 002 and DeepMimic's file: the clip as recorded)."""
     root_orientation: str = "world"
     """Frame of the root's orientation in the observation: world, the reference cycle's frame (the world frame when cycles do not turn), so the policy sees the heading the bounds hold (002 §4.1: every kinematic quantity in the motion-direction frame except the root orientation; authors' code: use_global_root_ori); heading: in the root's own heading frame like the other links (jt before 2026-12, which hides the heading drift that ends the walk by its lateral CoM bound)."""
     velocities: str = "joints"

@@ -18,11 +18,13 @@ answers, at any clip time ``t`` (``sample``) or phase (``at_phase``):
   (the walk turns 0.12 rad per cycle, the run 0.09). Without it (the authors' code), each cycle
   is shifted by ``Clip.cycle_offset()`` only and the heading snaps back at every seam. A
   non-looping clip holds its last frame (zero velocities) after its end.
-* ``straighten`` removes a looping clip's heading drift before any of this: the root's yaw about +y
-  minus a ramp linear in clip time from 0 to the cycle's turn, so the last frame faces as the
-  first and cycles neither turn nor snap (the walk's root turns 0.12 rad over a cycle while its
-  root positions go straight along x: the body faces up to 0.12 rad off the way it walks; the
-  authors' walk file has the root's rotation removed altogether).
+* ``straighten`` removes the root's yaw from every frame of a looping clip before any of this
+  (each frame's root turned about +y to face as the first frame; pitch, roll, positions and joints
+  kept), so the clip faces the way it travels and cycles neither turn nor snap. The shipped walk
+  needs it: its root yaw falls 0 -> -0.13 rad over the first step, jumps back to 0 between frames
+  18 and 19 (the second step is the first mirrored, yaw negated, but not offset) and ends at
+  +0.12 rad, so the 0.12 rad "turn per cycle" is that jump, not a turn of the path (its root
+  positions go straight along x); the authors' walk file has no root rotation at all.
 
 The heading frame turns about +y (y-up world): ``heading_axis`` x (the humanoid's forward axis)
 or z (backflip, roll, crawl: x points up or down during the motion; authors' code).
@@ -130,13 +132,12 @@ def clip_turn(clip: Any, axis: str = "x") -> float:
 
 
 def straightened(clip: Any, axis: str = "x") -> Any:
-    """``clip`` with its heading drift removed: frame ``i``'s root rotation turned about +y by
-    ``-turn (t_i - t_0) / T`` (``turn = clip_turn``), positions and joints unchanged."""
-    turn = clip_turn(clip, axis)
-    t = np.asarray(clip.times, dtype=float)
-    a = -turn * (t - t[0]) / (t[-1] - t[0])
-    yaw = np.stack([np.zeros_like(a), np.sin(0.5 * a), np.zeros_like(a), np.cos(0.5 * a)], axis=1)
-    return dataclasses.replace(clip, root_rot=rot.quat_multiply(yaw, np.asarray(clip.root_rot, dtype=float)))
+    """``clip`` with its root's yaw removed: every frame's root rotation turned about +y so that its
+    heading (``heading_quat``) is the first frame's; positions and joints unchanged."""
+    q = np.asarray(clip.root_rot, dtype=float)
+    h = np.array([heading_quat(q[i], axis) for i in range(len(q))])  # (n_frames, 4) x y z w
+    yaw = rot.quat_multiply(np.broadcast_to(h[0], h.shape), rot.quat_conjugate(h))
+    return dataclasses.replace(clip, root_rot=rot.quat_multiply(yaw, q))
 
 
 @dataclasses.dataclass(frozen=True)
