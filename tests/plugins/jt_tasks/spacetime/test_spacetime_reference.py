@@ -182,3 +182,41 @@ def test_heading_quat_is_the_general_yaw_quaternion_bit_for_bit():
             expect = rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), yaw)
             got = heading_quat(q, axis)
             assert np.array_equal(got, expect) and np.array_equal(np.signbit(got), np.signbit(expect))
+
+
+def test_the_shipped_walks_turn_is_a_yaw_jump_at_its_mirrored_half():
+    """The data ``straighten`` answers: the walk's root yaw jumps back 0.125 rad between frames 18
+    and 19 (its second step is the first mirrored, yaw negated, not offset) while its root path
+    goes straight along x; the 0.12 rad per cycle is that jump."""
+    c = SpacetimeReference("walk", cycle_turn=False).clip
+    yaw = np.array([_yaw(c.root_rot[i]) for i in range(c.n_frames)])
+    step = np.diff(yaw)
+    assert step[18] == pytest.approx(0.125, abs=0.005)
+    assert np.abs(np.delete(step, 18)).max() < 0.03
+    np.testing.assert_allclose(yaw[19:19 + 18], -yaw[:18], atol=1e-3)
+    assert abs(c.root_pos[:, 2]).max() < 0.02 and c.root_pos[-1, 0] > 1.2
+
+
+@pytest.mark.parametrize("clip", ["walk", "run"])
+def test_a_straightened_clip_faces_as_its_first_frame_and_keeps_the_rest(clip):
+    from toolkit.motion.rotations import quat_rotate
+
+    raw, r = SpacetimeReference(clip), SpacetimeReference(clip, straighten=True)
+    a, b = raw.clip, r.clip
+    assert abs(raw.turn) > 0.05 and r.turn == pytest.approx(0.0, abs=1e-9)
+    up = np.array([0.0, 1.0, 0.0])
+    for i in range(b.n_frames):
+        assert _yaw(b.root_rot[i]) == pytest.approx(_yaw(a.root_rot[0]), abs=1e-6)
+        # pitch and roll kept: the root's up axis makes the same angle with the vertical
+        assert quat_rotate(b.root_rot[i], up)[1] == pytest.approx(quat_rotate(a.root_rot[i], up)[1], abs=1e-9)
+    np.testing.assert_array_equal(b.root_pos, a.root_pos)
+    np.testing.assert_array_equal(b.joints, a.joints)
+    # no cycle turns: cycle 3 faces as cycle 0, shifted by three offsets
+    s0, s3 = r.at_phase(0.4, 0), r.at_phase(0.4, 3)
+    assert rot.quat_angle(s0.q[3:7], s3.q[3:7]) < 1e-6
+    np.testing.assert_allclose(s3.q[:3] - s0.q[:3], 3 * r.offset, atol=1e-9)
+
+
+def test_straighten_leaves_a_clip_that_does_not_loop():
+    raw, r = SpacetimeReference("walk", loop=False), SpacetimeReference("walk", loop=False, straighten=True)
+    np.testing.assert_array_equal(r.clip.root_rot, raw.clip.root_rot)
