@@ -48,7 +48,7 @@ class SpacetimeConfig(PolicyConfig):
     ground_clearance: float = 0.001
     """M, a start that penetrates the ground is lifted so that its lowest point is this high; other starts and the reference are the clip's own (authors' code: 0.001)."""
     cycle_turn: bool = True
-    """A looping clip's next cycle carries on its heading change (the walk turns 0.12 rad per cycle), so the reference is where a character tracking the clip goes (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam)."""
+    """A looping clip's next cycle carries on its heading change from first to last frame (walk 0.12 rad, run -0.09), so the heading does not snap back at the seam (ours; the authors' code shifts each cycle by the root's position change only: the heading snaps back at every seam). The walk's 0.12 rad is a yaw jump in its data, not a turn of its path: task.straighten removes it."""
     straighten: bool = False
     """Remove the root's yaw from every frame of a looping clip (each frame faces as the first; pitch, roll, positions, joints kept), so the clip faces the way it travels and cycles do not turn (ours; the shipped walk's root yaw jumps 0.125 rad mid-cycle and ends 0.12 rad from its start while its path goes straight; the authors' walk file has no root rotation at all; 002 and DeepMimic's file: the clip as recorded)."""
     root_orientation: str = "world"
