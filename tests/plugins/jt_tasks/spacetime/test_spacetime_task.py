@@ -94,7 +94,9 @@ def test_the_table1_preset_is_the_measured_walk_run_with_its_cost():
     assert cfg.task.clip == "walk" and cfg.agent.total_samples == 1001 * 4096 and cfg.agent.n_workers == 2
     assert cfg.agent.policy_lr == 2.5e-6 and cfg.agent.optimizer == "sgd" and cfg.action.output_scale == "range"
     assert (cfg.task.eval_every, cfg.task.eval_starts, cfg.task.termination) == (10, 4, "bounds")
-    assert "min" in str(cfg.cost) and "2 cores" in str(cfg.cost)
+    assert "min" in str(cfg.cost) and "2 cores" in str(cfg.cost) and str(cfg.cost).startswith("4100096 samples")
+    _, half = task("experiment=table1", "agent.total_samples=2048000")
+    assert str(half.cost).startswith("2048000 samples")  # the cost line says the budget the run has
     _, run = task("experiment=table1", "task.clip=run")
     assert run.task.clip == "run" and run.agent.total_samples == cfg.agent.total_samples
 
