@@ -147,6 +147,23 @@ def find_in(folder: Path, artifact: str, accept: Optional[Callable[[Path], bool]
     return None
 
 
+def run_config(artifact: Any, config: Optional[str] = None) -> Path:
+    """The ``config.yaml`` of the run that wrote ``artifact``: ``config`` if given, else the one in
+    the artifact's folder or the folder above (a run's artifacts and its work folder both hold one).
+
+    Raises:
+        JtError: one line: ``config`` is not a file, or no config.yaml beside ``artifact``.
+    """
+    if config is not None:
+        if not Path(config).is_file():
+            raise JtError(f"--config={config}: no such file")
+        return Path(config)
+    for folder in Path(artifact).parents[:2]:
+        if (folder / "config.yaml").is_file():
+            return folder / "config.yaml"
+    raise JtError(f"no config.yaml beside {artifact} (the run's work folder); pass --config")
+
+
 def _key_of(best_by: BestBy) -> Callable[[Any], Any]:
     """A sort key (larger is better) of a run from ``best_by`` (a function, or metric names)."""
     if callable(best_by):

@@ -146,7 +146,7 @@ def main(argv: Optional[list[str]] = None) -> None:
     from toolkit import plugins
     from toolkit.config import validate
     from toolkit.rl.checkpoint import load_policy
-    from toolkit.store.resolve import resolve
+    from toolkit.store.resolve import resolve, run_config
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("run", help="a task=getup run id (its best evaluation), a folder or a ppo.h5")
@@ -171,13 +171,11 @@ def main(argv: Optional[list[str]] = None) -> None:
         _fail(str(e))
     from omegaconf import OmegaConf
 
-    found = [Path(args.config)] if args.config else \
-        [p / "config.yaml" for p in Path(ref.path).parents[:2] if (p / "config.yaml").exists()]
-    if args.config and not found[0].is_file():
-        _fail(f"--config={args.config}: no such file")
-    if not found:
-        _fail(f"no config.yaml beside {ref.path} (the run's work folder); pass --config")
-    task = plugins.load("task", "getup")(validate(OmegaConf.load(found[0])))
+    try:
+        found = run_config(ref.path, args.config)
+    except JtError as e:
+        _fail(str(e))
+    task = plugins.load("task", "getup")(validate(OmegaConf.load(found)))
     env = task.make_env(None, seed=0)
     try:
         model = load_policy(ref.path)

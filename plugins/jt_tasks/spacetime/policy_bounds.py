@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import numpy as np
@@ -78,7 +77,7 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     from toolkit import plugins
     from toolkit.config import validate
     from toolkit.rl.checkpoint import load_policy
-    from toolkit.store.resolve import resolve
+    from toolkit.store.resolve import resolve, run_config
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("run", help="a task=spacetime run id, a folder holding ppo.h5, or the file")
@@ -92,12 +91,7 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds > 0):
         raise JtError(f"--seconds={args.seconds}: a finite number of seconds > 0 (e.g. --seconds 20)")
     ref = resolve(args.run, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
-    found = [Path(args.config)] if args.config else \
-        [p / "config.yaml" for p in Path(ref.path).parents[:2] if (p / "config.yaml").exists()]
-    if not found or not found[0].is_file():
-        raise JtError(f"no config.yaml {'at ' + args.config if args.config else 'beside ' + str(ref.path)}; "
-                      "pass --config with the run's config.yaml")
-    cfg = validate(OmegaConf.load(found[0]))
+    cfg = validate(OmegaConf.load(run_config(ref.path, args.config)))
     if cfg.task.name != "spacetime":
         raise JtError(f"run {args.run}: a task={cfg.task.name} run; this study reads task=spacetime runs")
     env = plugins.load("task", "spacetime")(cfg).make_env(None, seed=0)

@@ -15,7 +15,7 @@ answers, at any clip time ``t`` (``sample``) or phase (``at_phase``):
   root onto the last frame's (its yaw ``turn`` about +y and its shift): ``T(x) = R(turn) (x - p_0)
   + p_N`` on horizontal positions, ``R(turn)`` on the root rotation and the root velocities, so a
   character that tracks the clip's own steps keeps following its reference across the seam
-  (the walk turns 0.12 rad per cycle, the run 0.09). Without it (the authors' code), each cycle
+  (walk 0.12 rad per cycle, run -0.09: for the walk a yaw jump in its data, see ``straighten``). Without it (the authors' code), each cycle
   is shifted by ``Clip.cycle_offset()`` only and the heading snaps back at every seam. A
   non-looping clip holds its last frame (zero velocities) after its end.
 * ``straighten`` removes the root's yaw from every frame of a looping clip before any of this
@@ -126,8 +126,7 @@ def heading_frame(root_q: np.ndarray, points: np.ndarray, axis: str = "x",
 
 def clip_turn(clip: Any, axis: str = "x") -> float:
     """Rad, the heading change about +y from a clip's first frame to its last (in ``(-pi, pi]``)."""
-    yaw = [2.0 * math.atan2(heading_quat(clip.root_rot[i], axis)[1], heading_quat(clip.root_rot[i], axis)[3])
-           for i in (0, -1)]
+    yaw = [2.0 * math.atan2(h[1], h[3]) for h in (heading_quat(clip.root_rot[i], axis) for i in (0, -1))]
     return float(math.remainder(yaw[1] - yaw[0], 2.0 * math.pi))
 
 
@@ -165,7 +164,7 @@ class SpacetimeReference:
         heading_axis: ``x`` or ``z``.
         loop: override the clip's own ``Loop`` flag (None: keep it; every shipped clip wraps).
         cycle_turn: carry the clip's heading change per cycle into the next cycles (module docstring).
-        straighten: remove a looping clip's heading drift over the cycle first (module docstring).
+        straighten: remove the root's yaw from every frame of a looping clip first (module docstring).
 
     Attributes:
         turn: rad, the heading change over one cycle (last frame minus first; 0 for a non-looping

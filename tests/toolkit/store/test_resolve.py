@@ -167,3 +167,20 @@ def test_search_runs_by_tags_params_and_status(store):
     assert [r.info.run_id for r in kids] == [runs["kid2"]]
     with pytest.raises(JtError):
         search_runs(st, exp, tags={"mlflow.parentRunId": "x' or '1' = '1"})
+
+
+def test_run_config_is_the_one_beside_the_artifact_or_one_folder_up(tmp_path):
+    from toolkit.store.resolve import run_config
+
+    (tmp_path / "eval_0000").mkdir()
+    art = tmp_path / "eval_0000" / "ppo.h5"
+    art.write_bytes(b"")
+    with pytest.raises(JtError, match=r"no config.yaml beside .*ppo.h5 \(the run's work folder\); pass --config"):
+        run_config(art)
+    (tmp_path / "config.yaml").write_text("a: 1\n")
+    assert run_config(art) == tmp_path / "config.yaml"
+    (tmp_path / "eval_0000" / "config.yaml").write_text("a: 2\n")
+    assert run_config(art) == tmp_path / "eval_0000" / "config.yaml"  # the nearer one
+    with pytest.raises(JtError, match=r"--config=.*nope.yaml: no such file"):
+        run_config(art, str(tmp_path / "nope.yaml"))
+    assert run_config(art, str(tmp_path / "config.yaml")) == tmp_path / "config.yaml"
