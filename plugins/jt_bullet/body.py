@@ -3,7 +3,8 @@
 ``BulletBody`` reads ``(q, qd)`` with one batched ``getJointStatesMultiDof`` call, writes
 generalised forces with one ``setJointMotorControlMultiDofArray`` call (root forces, if any, as
 an external world force at the base's centre of mass and a world torque), and drives PyBullet's
-own C++ Stable PD (``STABLE_PD_CONTROL``, which acts inside the next ``stepSimulation``).
+own C++ Stable PD (``STABLE_PD_CONTROL``, which acts inside the next ``stepSimulation``) or its
+constraint motors (``POSITION_CONTROL``, ``spd=servo``).
 
 PyBullet limits: its shared-memory API carries at most ``MAX_DEGREE_OF_FREEDOM = 128`` position
 coordinates per body. Beyond that (e.g. the 195-DoF snake, ``n_q = 259``) joint states read back
@@ -134,6 +135,33 @@ class BulletBody:
         pb.setJointMotorControlMultiDofArray(self.body, self.joints, pb.STABLE_PD_CONTROL,
                                              targetPositions=tp, targetVelocities=tv, forces=fl,
                                              positionGains=gp, velocityGains=gd, **kw)
+
+    def servo(self, q_target: np.ndarray, torque_limit: np.ndarray, qd_target: np.ndarray | None = None,
+              position_gain: float = 0.1, velocity_gain: float = 1.0) -> None:
+        """Arm PyBullet's constraint motors (``POSITION_CONTROL``) towards ``q_target``; they stay
+        armed through every later ``stepSimulation`` until re-armed (root unactuated).
+
+        Each joint is a velocity constraint, solved with the contacts, driving the joint by
+        ``position_gain`` of its position error per step (plus ``velocity_gain`` of its velocity
+        error) with at most ``torque_limit`` per DoF: a stiff servo bounded by the torque limits.
+        """
+        pb, kw = self.pb, self._kw
+        qt = np.asarray(q_target, dtype=float).tolist()
+        vt = (np.zeros(self.model.n_v) if qd_target is None
+              else np.asarray(qd_target, dtype=float)).tolist()
+        lim = np.asarray(torque_limit, dtype=float).tolist()
+        kq = 7 if self.floating else 0
+        tp, tv, fl = [], [], []
+        for (a, e), nq in zip(self._vslices, self.nq_j):
+            tp.append(qt[kq:kq + nq])
+            tv.append(vt[a:e])
+            fl.append(lim[a:e])
+            kq += nq
+        n = len(self.joints)
+        pb.setJointMotorControlMultiDofArray(self.body, self.joints, pb.POSITION_CONTROL,
+                                             targetPositions=tp, targetVelocities=tv, forces=fl,
+                                             positionGains=[float(position_gain)] * n,
+                                             velocityGains=[float(velocity_gain)] * n, **kw)
 
     def step(self) -> None:
         """One ``stepSimulation``."""

@@ -15,16 +15,17 @@ import numpy as np
 
 from toolkit.interfaces.simulator import Watch
 
-_KERNELS = {"maba": -1, "df": 0, "sf": 1, "pcg": 2}
+_KERNELS = {"maba": -1, "df": 0, "sf": 1, "pcg": 2, "servo": 3}
 _CHECKER_REASONS = {1: "NaN state", 4: "non-finite SPD torques (NaN or exploding state)"}
 
 
 def unavailable(sim: Any) -> str:
     """Why ``sim`` (a ``BulletSimulator``) cannot step through the compiled loop; "" if it can."""
     be = sim.backend
-    if sim.steps_itself:
+    servo = getattr(be, "method", None) == "servo"  # motors armed once per control step, no kernel
+    if sim.steps_itself and not servo:
         return f"spd={sim.spd_name} steps inside PyBullet itself"
-    if getattr(be, "method", None) not in _KERNELS or not hasattr(be, "data"):
+    if getattr(be, "method", None) not in _KERNELS or not (servo or hasattr(be, "data")):
         return f"the SPD backend {type(be).__name__} has no toolkit.dynamics kernel"
     if not sim.character.fixed_base and np.any(sim.torque_limit[:6] != 0.0):
         return "a root servo (its forces go through applyExternalForce)"
@@ -81,6 +82,13 @@ class CompiledSteps:
         self.pts = np.zeros(capi.POINT_WORDS * 1024, np.int32)
         self.ls = np.zeros(fastloop.LINK_STATE_DOUBLES)
         self.method = _KERNELS[be.method]
+        if self.method == fastloop.SERVO:  # no SPD kernel: scratch arrays of the loop's signature
+            from toolkit.dynamics.model import Data
+
+            self.data = Data(m)
+            self.data.tau[:] = np.nan  # PyBullet reports no motor torques (as the Python loop)
+        else:
+            self.data = be.data
         self.tol = float(getattr(be, "tol", 1e-12))
         self.max_iter = int(getattr(be, "max_iter_factor", 20)) * m.n_v
         self.zeros = np.zeros(m.n_v)
@@ -163,8 +171,10 @@ class CompiledSteps:
         cap, w, active, every, rules, touches, flags, r_time, r_com, r_root, t_lim = self._pack(watch, n)
         touched = np.zeros((len(touches), self._n_links + 1), np.bool_)
         touched_any = np.zeros(len(touches), np.bool_)
-        d = be.data
+        d = self.data
         io = sim.io
+        if self.method == self.fl.SERVO:
+            be.apply(qt, sim.kp, sim.kd, sim.torque_limit, vt)  # the motors hold it through the substeps
         self.fl.substeps(
             self.fns, self.h, self.body, int(n), every, active, qt,
             self.zeros if vt is None else vt, sim.kp, sim.kd, sim.torque_limit, sim.dt, sim.time,

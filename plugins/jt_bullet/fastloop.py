@@ -30,8 +30,9 @@ from toolkit.dynamics.spd import spd_system_kernel
 
 #: failure codes of ``substeps`` (``iout[1]``)
 OK, NAN_STATE, FAST, FAR, BAD_TORQUE = 0, 1, 2, 3, 4
-#: SPD kernels (``method``): MABA, or the explicit system by DF / SF / PCG (spd_system_kernel's modes)
-MABA, DF, SF, PCG = -1, 0, 1, 2
+#: SPD kernels (``method``): MABA, or the explicit system by DF / SF / PCG (spd_system_kernel's modes);
+#: SERVO: no torques at all (``spd=servo``: PyBullet's constraint motors, armed before the loop)
+MABA, DF, SF, PCG, SERVO = -1, 0, 1, 2, 3
 #: ``iout`` entries: substeps done, failure code, fired rule (-1: none, -2: the time limit), records, PCG iterations
 I_DONE, I_FAIL, I_RULE, I_REC, I_ITS = range(5)
 #: ``timers`` entries (seconds): SPD, physics, state/torque I/O, whole substeps
@@ -252,28 +253,31 @@ def substeps(fns, h, body, n, every, active, qt, qdt, kp, kd, lim, dt, t,
     vmax = 0.0
     for k in range(n):
         t0 = _now(fns, ts)
-        if method == MABA:
-            maba_kernel(mi, mf, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv, sc)
+        if method == SERVO:  # the motors act inside the step
+            t1 = t0
         else:
-            its = spd_system_kernel(mi, mf, lam, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv,
-                                    sc, H, A, method, tol, max_iter)
-        t1 = _now(fns, ts)
-        s = 0.0
-        for i in range(nv):
-            x = tau[i]
-            if x > lim[i]:  # np.minimum / np.maximum keep a NaN, as these comparisons do
-                x = lim[i]
-            if x < -lim[i]:
-                x = -lim[i]
-            tau[i] = x
-            s += x
-        if not np.isfinite(s):
-            fail = BAD_TORQUE
-            break
-        cmd = _control_init(fns[CONTROL_INIT], (h, body, 1))  # CONTROL_MODE_TORQUE
-        for j in range(j_uindex.shape[0]):
-            _set_forces(fns[SET_FORCES], (cmd, j_uindex[j], tau.ctypes.data + 8 * j_start[j], j_count[j]))
-        _submit(fns[SUBMIT], (h, cmd))
+            if method == MABA:
+                maba_kernel(mi, mf, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv, sc)
+            else:
+                its = spd_system_kernel(mi, mf, lam, q, qd, qt, qdt, kp, kd, dt, zeros, grav, wb, wv,
+                                        sc, H, A, method, tol, max_iter)
+            t1 = _now(fns, ts)
+            s = 0.0
+            for i in range(nv):
+                x = tau[i]
+                if x > lim[i]:  # np.minimum / np.maximum keep a NaN, as these comparisons do
+                    x = lim[i]
+                if x < -lim[i]:
+                    x = -lim[i]
+                tau[i] = x
+                s += x
+            if not np.isfinite(s):
+                fail = BAD_TORQUE
+                break
+            cmd = _control_init(fns[CONTROL_INIT], (h, body, 1))  # CONTROL_MODE_TORQUE
+            for j in range(j_uindex.shape[0]):
+                _set_forces(fns[SET_FORCES], (cmd, j_uindex[j], tau.ctypes.data + 8 * j_start[j], j_count[j]))
+            _submit(fns[SUBMIT], (h, cmd))
         t2 = _now(fns, ts)
         _submit(fns[SUBMIT], (h, _step_init(fns[STEP_INIT], (h,))))
         t3 = _now(fns, ts)

@@ -71,6 +71,6 @@ class BulletBackend(SPDBackend):
     def torques(self, q: Any, qd: Any, q_target: Any, kp: Any, kd: Any, dt: float,
                 qd_target: Any = None, tau_ext: Any = None) -> Any:
         raise NotImplementedError(
-            "spd=bullet computes its torques inside PyBullet's stepSimulation and never returns "
-            "them; call apply(q_target, kp, kd, torque_limit) before each stepSimulation "
+            f"spd={self.params.name} computes its torques inside PyBullet's stepSimulation "
+            "and never returns them; call apply(q_target, kp, kd, torque_limit) before each stepSimulation "
             "(steps_itself is True)")

@@ -12,7 +12,7 @@ from toolkit.interfaces import Executor, Searcher, Task
 EXPECTED_BUILTINS = {
     "executor": {"local", "ray"},
     "search": {"single", "random", "bds", "rmoo", "bsoo"},
-    "spd": {"maba", "df", "sf", "pcg", "bullet"},
+    "spd": {"maba", "df", "sf", "pcg", "bullet", "servo"},
     "action": {"raw", "pvae", "cvae", "ffc_fbc"},
     "reward": {"task_complete", "root_rotation", "safety", "naturalness", "novelty"},
     "curriculum": {"bar_height", "obstacle_width", "terrain"},

@@ -88,3 +88,31 @@ def test_one_sagittal_ankle_law_keeps_the_symmetric_stance_up_and_not_the_clips_
     assert _ankle_feedback_stands(sym, sym.stand_state[0], 3.0, 0.0, 0.0) < 2.0
     assert _ankle_feedback_stands(sym, sym.stand_state[0], 5.0) == 5.0
     assert _ankle_feedback_stands(clip, clip.stand_state[0], 5.0) < 2.0
+
+
+def test_constraint_servos_hold_the_symmetric_stance_where_stable_pd_lets_it_fall(envs):
+    """Why SPD cannot hold a stance (docs/getup.md, "Servos solved with the contacts"): Stable PD
+    predicts a planted foot's acceleration from its own tiny inertia, so the ankle's torque is a
+    small share of its gain's. ``spd=servo`` (PyBullet's constraint motors, solved with the contacts)
+    holds the symmetric stance 5 s with no feedback at all, also from perturbed starts; the clip's
+    frame (one foot 2 cm up) is no stance and falls either way."""
+    from tests.plugins.jt_tasks.getup.test_getup_stage1 import make_task
+
+    sym = envs["symmetric"]
+    assert _ankle_feedback_stands(sym, sym.stand_state[0], 3.0, 0.0, 0.0) < 2.0  # SPD (df)
+    made = {k: make_task("spd=servo", f"task.stand_pose={k}", "task.p_standing=1.0", "task.p_fallen=0")
+            .make_env(None, seed=0) for k in ("clip", "symmetric")}
+    try:
+        servo = made["symmetric"]
+        assert servo.sim.spd_name == "servo"
+        rng = np.random.default_rng(0)
+        for k in range(3):
+            q = np.array(servo.stand_state[0])
+            if k:
+                q[7:] += rng.normal(0.0, 0.02, size=len(q) - 7)  # ~0.02 rad per joint (PyBullet normalises)
+            assert _ankle_feedback_stands(servo, q, 5.0, 0.0, 0.0) == 5.0, k
+        clip = made["clip"]
+        assert _ankle_feedback_stands(clip, clip.stand_state[0], 3.0, 0.0, 0.0) < 2.0
+    finally:
+        for e in made.values():
+            e.close()
