@@ -120,3 +120,29 @@ def test_style_presets_loosen_the_bounds_and_add_their_term(preset, clip, term, 
     names = channel_names(HUMANOID)
     for channel, w in widths.items():
         assert spec.widths[names.index(channel)] == w, channel
+
+
+def test_the_laptop_preset_is_the_setting_measured_to_reach_20_s():
+    """``experiment=laptop``: ``experiment=table1``'s walk with the three measured deviations (the
+    FFC's lead and target velocities, the CoM in height only), the links' velocities, 2.05 M samples;
+    its cost line first; the horizontal CoM box comes back as the preset's comment says."""
+    from jt_tasks.spacetime import bounds as bd
+    from toolkit.motion.skeletons import HUMANOID
+
+    _, table1 = task("experiment=table1")
+    _, cfg = task("experiment=laptop")
+    assert cfg.task.clip == "walk" and cfg.agent.total_samples == 500 * 4096 and cfg.agent.n_workers == 2
+    assert (cfg.task.ffc_lead, cfg.task.ffc_velocity, cfg.task.velocities) == (1, True, "links")
+    for key in ("policy_lr", "optimizer", "samples_per_iteration"):
+        assert cfg.agent[key] == table1.agent[key], key
+    assert (cfg.task.eval_every, cfg.task.eval_starts, cfg.task.termination) == (10, 4, "bounds")
+    w = bd.widths(HUMANOID, cfg.task.com_width, cfg.task.orientation_width, cfg.task.end_effector_width,
+                  dict(cfg.task.widths))
+    assert np.isinf(w[0]) and w[1] == 0.2 and np.isinf(w[2]) and np.isfinite(w[3:]).all()  # CoM x, z off
+    assert str(cfg.cost).startswith("2048000 samples") and "2 cores" in str(cfg.cost)
+    _, box = task("experiment=laptop", "task.widths.com_x=0.2", "task.widths.com_z=0.2")
+    wb = bd.widths(HUMANOID, box.task.com_width, box.task.orientation_width, box.task.end_effector_width,
+                   dict(box.task.widths))
+    assert np.allclose(wb[:3], 0.2)
+    _, run = task("experiment=laptop", "task.clip=run")
+    assert run.task.clip == "run" and run.agent.total_samples == cfg.agent.total_samples
