@@ -73,7 +73,11 @@ def test_same_seed_same_trajectory_as_before_the_rewrite(name, request):
     if os.environ.get("JT_RECORD_GOLDEN"):
         golden.save(own, got)
     if own.exists():
-        golden.compare(got, golden.load(own))
+        # flat_cvae's prior is trained in the test by torch in float32: two machines with the same key
+        # (an "AMD EPYC" of another generation) differ in the last float32 digit of a few decoded
+        # poses (8 of 29 886 observation entries by 1e-7 relative, measured), nothing more
+        tol = {"rtol": 1e-5, "atol": 1e-7} if name == "flat_cvae" else {}
+        golden.compare(got, golden.load(own), **tol)
     else:  # another machine: the first control steps, loosely (chaos amplifies the last digits)
         other = sorted(GOLDEN.glob(f"{name}.*.npz"))
         assert other, f"no recording of {name}"
