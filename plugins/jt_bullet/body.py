@@ -112,32 +112,38 @@ class BulletBody:
             pb.applyExternalTorque(b, -1, t[3:6], pb.WORLD_FRAME, **kw)
         return True
 
+    def _per_joint(self, q_target: np.ndarray, torque_limit: np.ndarray,
+                   qd_target: np.ndarray | None) -> tuple[list, list, list, list[int]]:
+        """Target positions, target velocities and force limits as PyBullet's per-joint lists, and
+        each joint's first DoF index (in the ``qd`` layout)."""
+        qt = np.asarray(q_target, dtype=float).tolist()
+        vt = (np.zeros(self.model.n_v) if qd_target is None
+              else np.asarray(qd_target, dtype=float)).tolist()
+        lim = np.asarray(torque_limit, dtype=float).tolist()
+        kq = 7 if self.floating else 0
+        tp, tv, fl, first = [], [], [], []
+        for (a, e), nq in zip(self._vslices, self.nq_j):
+            tp.append(qt[kq:kq + nq])
+            tv.append(vt[a:e])
+            fl.append(lim[a:e])
+            first.append(a)
+            kq += nq
+        return tp, tv, fl, first
+
     def stable_pd(self, q_target: np.ndarray, kp: np.ndarray, kd: np.ndarray,
                   torque_limit: np.ndarray, qd_target: np.ndarray | None = None) -> None:
         """Arm PyBullet's C++ Stable PD for the next ``stepSimulation`` (root unactuated).
 
         PyBullet takes one gain per joint: the gain of each joint's first DoF is used.
         """
-        pb, kw = self.pb, self._kw
-        qt = np.asarray(q_target, dtype=float).tolist()
-        vt = (np.zeros(self.model.n_v) if qd_target is None
-              else np.asarray(qd_target, dtype=float)).tolist()
-        lim = np.asarray(torque_limit, dtype=float).tolist()
-        kq = 7 if self.floating else 0
-        tp, tv, fl, gp, gd = [], [], [], [], []
-        for (a, e), nq in zip(self._vslices, self.nq_j):
-            tp.append(qt[kq:kq + nq])
-            tv.append(vt[a:e])
-            fl.append(lim[a:e])
-            gp.append(float(kp[a]))
-            gd.append(float(kd[a]))
-            kq += nq
-        pb.setJointMotorControlMultiDofArray(self.body, self.joints, pb.STABLE_PD_CONTROL,
-                                             targetPositions=tp, targetVelocities=tv, forces=fl,
-                                             positionGains=gp, velocityGains=gd, **kw)
+        tp, tv, fl, first = self._per_joint(q_target, torque_limit, qd_target)
+        self.pb.setJointMotorControlMultiDofArray(
+            self.body, self.joints, self.pb.STABLE_PD_CONTROL, targetPositions=tp, targetVelocities=tv,
+            forces=fl, positionGains=[float(kp[a]) for a in first], velocityGains=[float(kd[a]) for a in first],
+            **self._kw)
 
     def servo(self, q_target: np.ndarray, torque_limit: np.ndarray, qd_target: np.ndarray | None = None,
-              position_gain: float = 0.1, velocity_gain: float = 1.0) -> None:
+              position_gain: float = 0.3, velocity_gain: float = 1.0) -> None:
         """Arm PyBullet's constraint motors (``POSITION_CONTROL``) towards ``q_target``; they stay
         armed through every later ``stepSimulation`` until re-armed (root unactuated).
 
@@ -145,23 +151,12 @@ class BulletBody:
         ``position_gain`` of its position error per step (plus ``velocity_gain`` of its velocity
         error) with at most ``torque_limit`` per DoF: a stiff servo bounded by the torque limits.
         """
-        pb, kw = self.pb, self._kw
-        qt = np.asarray(q_target, dtype=float).tolist()
-        vt = (np.zeros(self.model.n_v) if qd_target is None
-              else np.asarray(qd_target, dtype=float)).tolist()
-        lim = np.asarray(torque_limit, dtype=float).tolist()
-        kq = 7 if self.floating else 0
-        tp, tv, fl = [], [], []
-        for (a, e), nq in zip(self._vslices, self.nq_j):
-            tp.append(qt[kq:kq + nq])
-            tv.append(vt[a:e])
-            fl.append(lim[a:e])
-            kq += nq
+        tp, tv, fl, _ = self._per_joint(q_target, torque_limit, qd_target)
         n = len(self.joints)
-        pb.setJointMotorControlMultiDofArray(self.body, self.joints, pb.POSITION_CONTROL,
-                                             targetPositions=tp, targetVelocities=tv, forces=fl,
-                                             positionGains=[float(position_gain)] * n,
-                                             velocityGains=[float(velocity_gain)] * n, **kw)
+        self.pb.setJointMotorControlMultiDofArray(
+            self.body, self.joints, self.pb.POSITION_CONTROL, targetPositions=tp, targetVelocities=tv,
+            forces=fl, positionGains=[float(position_gain)] * n, velocityGains=[float(velocity_gain)] * n,
+            **self._kw)
 
     def step(self) -> None:
         """One ``stepSimulation``."""

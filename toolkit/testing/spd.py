@@ -140,6 +140,16 @@ class SPDBackendSuite:
             finally:
                 w.close()
 
+    def test_a_backend_that_steps_itself_returns_no_torques(self, humanoid):
+        """``steps_itself`` (PyBullet's own controllers): ``torques`` raises, naming the backend."""
+        if not self.backend_cls.steps_itself:
+            pytest.skip("returns its torques")
+        w = humanoid
+        backend = self.make()
+        backend.bind(w.io)
+        with pytest.raises(NotImplementedError, match=f"spd={backend.params.name} computes its torques"):
+            backend.torques(w.q_init, np.zeros(w.model.n_v), w.q_init, w.kp, w.kd, DT)
+
     def test_unbound_backend_says_so(self):
         backend = self.make()
         q = np.zeros(7)

@@ -15,14 +15,6 @@ class TestBulletBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = BulletBackend
     reference_exact = False
 
-    def test_steps_itself_and_never_returns_torques(self, humanoid):
-        ch = humanoid.character
-        b = BulletBackend(None)
-        b.bind(ch)
-        assert b.steps_itself is True
-        with pytest.raises(NotImplementedError, match="stepSimulation"):
-            b.torques(ch.q_init, np.zeros(ch.n_dof), ch.q_init, ch.kp, ch.kd, DT)
-
     def test_bind_rejects_a_bare_model(self, humanoid):
         ch = humanoid.character
         with pytest.raises(TypeError, match="BulletBody or a Character"):

@@ -15,14 +15,6 @@ class TestServoBackend(BulletSPDWorlds, SPDBackendSuite):
     backend_cls = ServoBackend
     reference_exact = False
 
-    def test_steps_itself_and_never_returns_torques(self, humanoid):
-        ch = humanoid.character
-        b = ServoBackend(None)
-        b.bind(ch)
-        assert b.steps_itself is True
-        with pytest.raises(NotImplementedError, match="spd=servo"):
-            b.torques(ch.q_init, np.zeros(ch.n_dof), ch.q_init, ch.kp, ch.kd, DT)
-
 
 def test_a_fixed_arm_reaches_its_target_and_the_torque_limit_bounds_it():
     """A fixed-base humanoid hanging in gravity: with the character's limits the motors bring every
