@@ -53,6 +53,11 @@ class ServoBackend(BulletBackend):
                 raise JtError(f"spd.{key}={v:g}: must be in (0, 1] (a share of the error per step)")
         self._armed: tuple | None = None  # (io, q_target, torque_limit, qd_target) last armed
 
+    @classmethod
+    def check_run(cls, cfg: Any) -> None:
+        """The gains, checked at composition (before a run opens): one line for a bad one."""
+        cls(cfg.get("spd") if hasattr(cfg, "get") else None)
+
     def apply(self, q_target: Any, kp: Any, kd: Any, torque_limit: Any,
               qd_target: Any = None) -> None:
         """Arm the motors towards ``q_target`` for the next ``stepSimulation`` (``kp``, ``kd`` unused)."""

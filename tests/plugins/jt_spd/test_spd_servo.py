@@ -57,3 +57,13 @@ def test_a_gain_outside_zero_to_one_is_one_line(key, value):
 
     with pytest.raises(JtError, match=rf"spd.{key}=.*\(0, 1\]"):
         ServoBackend(OmegaConf.create({"name": "servo", key: value}))
+
+
+def test_a_bad_gain_stops_the_run_before_it_opens():
+    """Checked at composition (``check_run``), so no run is written for it."""
+    from toolkit.config import compose
+    from toolkit.errors import JtError
+
+    assert compose(["task=getup", "spd=servo"]).spd.name == "servo"  # the defaults pass
+    with pytest.raises(JtError, match=r"spd.position_gain=2: must be in \(0, 1\]"):
+        compose(["task=getup", "spd=servo", "spd.position_gain=2"])
