@@ -140,15 +140,20 @@ class SPDBackendSuite:
             finally:
                 w.close()
 
-    def test_a_backend_that_steps_itself_returns_no_torques(self, humanoid):
-        """``steps_itself`` (PyBullet's own controllers): ``torques`` raises, naming the backend."""
-        if not self.backend_cls.steps_itself:
-            pytest.skip("returns its torques")
+    def test_torques_come_back_unless_it_steps_itself(self, humanoid):
+        """``torques`` returns finite ``(n_v,)`` torques; a ``steps_itself`` backend (PyBullet's own
+        controllers) raises instead, naming itself."""
         w = humanoid
         backend = self.make()
-        backend.bind(w.io)
-        with pytest.raises(NotImplementedError, match=f"spd={backend.params.name} computes its torques"):
-            backend.torques(w.q_init, np.zeros(w.model.n_v), w.q_init, w.kp, w.kd, DT)
+        q, qd = w.q_init, np.zeros(w.model.n_v)
+        if self.backend_cls.steps_itself:
+            backend.bind(w.io)
+            with pytest.raises(NotImplementedError, match=f"spd={backend.params.name} computes its torques"):
+                backend.torques(q, qd, q, w.kp, w.kd, DT)
+            return
+        backend.bind(w.model)
+        tau = np.array(backend.torques(q, qd, q, w.kp, w.kd, DT))
+        assert tau.shape == (w.model.n_v,) and np.all(np.isfinite(tau))
 
     def test_unbound_backend_says_so(self):
         backend = self.make()
