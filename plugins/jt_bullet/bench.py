@@ -85,7 +85,8 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
 
     Args:
         model_names: characters, e.g. ``["humanoid", "snake36", "snake195"]``.
-        backends: any of ``maba``, ``df``, ``sf``, ``pcg``, ``bullet``.
+        backends: any of ``maba``, ``df``, ``sf``, ``pcg``, ``bullet``, and ``servo`` (PyBullet's
+            constraint motors, not an SPD: no solve time; not in the default ``BACKENDS``).
         n_samples: timed solves (random states) and timed substeps per backend.
         seed: seeds the random states and targets.
         dt: simulation time step (600 Hz as the jumping papers).
@@ -93,7 +94,7 @@ def time_spd(model_names: Sequence[str], backends: Sequence[str] = BACKENDS,
 
     Returns:
         One row per (model, backend): ``model``, ``dof``, ``depth``, ``backend``,
-        ``solve_us_median`` (NaN for ``bullet``, whose solve happens inside PyBullet's step) and
+        ``solve_us_median`` (NaN for ``bullet`` and ``servo``, whose solve happens inside PyBullet's step) and
         ``step_us_median`` (NaN where PyBullet cannot drive the body: more than 128 position
         coordinates, see ``jt_bullet.body``).
     """
@@ -156,6 +157,8 @@ def _time_steps(name: str, backends: Sequence[str], model: Model, kp: np.ndarray
             t0 = time.perf_counter_ns()
             if b == "bullet":
                 io.stable_pd(q_target, kp, kd, limit)
+            elif b == "servo":  # PyBullet's constraint motors (spd=servo): no SPD at all
+                io.servo(q_target, limit)
             else:
                 q, qd = io.read()
                 spd_solve(model, data, q, qd, q_target, kp, kd, dt, b)

@@ -23,6 +23,16 @@ def test_time_spd_rows_and_summary():
     assert "humanoid" in format_table(rows)
 
 
+def test_the_servo_motors_are_timed_beside_stable_pd_on_request():
+    """``servo`` (spd=servo's constraint motors) is opt-in: no solve time, a positive step time."""
+    from jt_bullet.bench import BACKENDS, time_spd
+
+    assert "servo" not in BACKENDS
+    rows = {r["backend"]: r for r in time_spd(["humanoid"], backends=("df", "servo"), n_samples=3, seed=0)}
+    assert math.isnan(rows["servo"]["solve_us_median"]) and rows["servo"]["step_us_median"] > 0
+    assert rows["df"]["solve_us_median"] > 0
+
+
 def test_check_agreement_reports_tiny_differences():
     from jt_bullet.bench import check_agreement
 
