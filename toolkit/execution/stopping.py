@@ -1,4 +1,4 @@
-"""Stopping a run at a safe point when asked to (SIGTERM).
+"""Stopping a run at a safe point when asked to (SIGTERM, Ctrl-C).
 
 A signal handler must not raise: an exception raised from it lands wherever the main thread
 happens to be, inside a weakref callback (where Python prints it and swallows it, and the run goes
@@ -9,10 +9,17 @@ calling ``check()``: between evaluations and store writes (the runner), after ea
 while the local executor waits for its workers. ``check()`` raises ``KeyboardInterrupt`` with the
 reason, which the runner turns into a KILLED run (exit 130, resumable). A second SIGTERM while
 the first is pending raises at once (a run stuck somewhere can still be stopped).
+
+Ctrl-C (SIGINT) is handled the same way while a run is open: Python's own handler raises
+``KeyboardInterrupt`` wherever the main thread is, and one that lands in a weakref callback or a
+``__del__`` is printed and swallowed, so the run went on to FINISHED. The first Ctrl-C now asks for
+a stop at the next safe point (one line says so), a second stops at once. Where SIGINT is ignored
+(a shell's background job) it stays ignored.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 from typing import Any, Optional
 
@@ -46,32 +53,42 @@ def check() -> None:
 
 
 class Terminate:
-    """While a run is open, SIGTERM requests a stop at the next safe point (``check``); a second
-    SIGTERM raises ``KeyboardInterrupt`` at once. Outside the main thread it changes nothing."""
+    """While a run is open, SIGTERM or Ctrl-C requests a stop at the next safe point (``check``); a
+    second one raises ``KeyboardInterrupt`` at once. Outside the main thread it changes nothing;
+    an ignored SIGINT (a background job) stays ignored."""
 
     REASON = "terminated (SIGTERM)"
+    REASON_INT = "interrupted (Ctrl-C)"
     _depth = 0  #: open Terminate blocks (a comparison's cells run inside its own)
 
     def __enter__(self) -> "Terminate":
         if Terminate._depth == 0:
             clear()
         Terminate._depth += 1
-        self._old: Any = signal.getsignal(signal.SIGTERM)
+        self._old: dict[int, Any] = {}
 
         def handler(signum: int, frame: Any) -> None:
+            reason = self.REASON_INT if signum == signal.SIGINT else self.REASON
             if requested() is not None:
-                raise KeyboardInterrupt(self.REASON)
-            request(self.REASON)
+                raise KeyboardInterrupt(reason)
+            request(reason)
+            if signum == signal.SIGINT:  # os.write: no buffered I/O inside a signal handler
+                os.write(2, b"\njt: stopping at the next safe point (Ctrl-C again to stop now)\n")
 
-        try:
-            signal.signal(signal.SIGTERM, handler)
-        except ValueError:  # not the main thread
-            self._old = None
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            old = signal.getsignal(sig)
+            if sig == signal.SIGINT and old is not signal.default_int_handler:
+                continue  # ignored (a background job) or someone else's: left as it is
+            try:
+                signal.signal(sig, handler)
+            except ValueError:  # not the main thread
+                break
+            self._old[sig] = old
         return self
 
     def __exit__(self, *exc: Any) -> None:
         Terminate._depth -= 1
-        if self._old is not None:
-            signal.signal(signal.SIGTERM, self._old)
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
         if Terminate._depth == 0:
             clear()

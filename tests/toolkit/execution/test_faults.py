@@ -359,3 +359,31 @@ def test_the_handler_only_records_the_request_and_a_second_one_raises():
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(0.5)  # the second signal raises where the main thread is
     assert stopping.requested() is None  # cleared when the run's block ends
+
+
+def test_ctrl_c_asks_for_a_safe_point_and_a_second_one_stops_at_once():
+    """Python's own SIGINT handler raises wherever the main thread is (inside a weakref callback it
+    is swallowed and the run goes on to FINISHED): while a run is open the first Ctrl-C is a
+    request, as SIGTERM is; an ignored SIGINT (a background job) stays ignored."""
+    from toolkit.execution import stopping
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a terminal
+    try:
+        with stopping.Terminate():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)  # nothing raised here
+            assert stopping.requested() == "interrupted (Ctrl-C)"
+            with pytest.raises(KeyboardInterrupt, match="Ctrl-C"):
+                stopping.check()
+            with pytest.raises(KeyboardInterrupt):
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        with stopping.Terminate():
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)
+            assert stopping.requested() is None
+    finally:
+        signal.signal(signal.SIGINT, old)
