@@ -80,11 +80,20 @@ def _die_with_parent(parent_pid: Optional[int], pdeathsig: bool) -> None:
                      daemon=True).start()
 
 
+def _ignore_ctrl_c() -> None:
+    """A terminal's Ctrl-C reaches every process of its group: a worker ignores it and the driver
+    decides (it stops the run at its next safe point and ends the workers, ``toolkit.execution.
+    stopping``); a worker killed by it mid-call would turn a KILLED, resumable run into a FAILED one."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _worker_init(parent_pid: Optional[int], pdeathsig: bool) -> None:
-    """Pool worker initializer: die with the driver, one BLAS/torch thread, no native banners."""
+    """Pool worker initializer: die with the driver, ignore Ctrl-C, one BLAS/torch thread, no
+    native banners."""
     from toolkit.quiet import preload_quietly
 
     _die_with_parent(parent_pid, pdeathsig)
+    _ignore_ctrl_c()
     _limit_threads()
     preload_quietly()
 
@@ -94,6 +103,7 @@ def _actor_main(conn: Any, factory: Callable[..., Any], args: tuple, parent_pid:
     from toolkit.quiet import preload_quietly
 
     _die_with_parent(parent_pid, pdeathsig)
+    _ignore_ctrl_c()
     _limit_threads()
     preload_quietly()
     try:

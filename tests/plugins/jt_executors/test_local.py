@@ -15,6 +15,13 @@ from jt_executors.local import LocalExecutor
 from toolkit.testing.executor import Counter, ExecutorContract
 
 
+def _interrupted(x: int) -> int:
+    """A pool task that gets a Ctrl-C (SIGINT) while it runs, then returns ``x``."""
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.1)
+    return x
+
+
 class TestLocalPool(ExecutorContract):
     executor_cls, entry, cfg = LocalExecutor, "local", {"name": "local", "workers": 2}
 
@@ -25,6 +32,20 @@ class TestLocalPool(ExecutorContract):
         finally:
             group.close()
         assert len(set(pids)) == 2 and os.getpid() not in pids
+
+    def test_a_ctrl_c_sent_to_the_workers_leaves_them_working(self, executor):
+        """A terminal's Ctrl-C signals the whole process group; the driver decides when to stop,
+        so actors and pool workers ignore it (a worker killed mid-call made a run FAILED)."""
+        group = executor.actors(Counter, [(0,), (0,)])
+        try:
+            pids = group.call("pid")
+            for pid in pids:
+                os.kill(pid, signal.SIGINT)
+            time.sleep(0.3)
+            assert group.call("add", [(1,), (2,)]) == [1, 2]
+        finally:
+            group.close()
+        assert executor.map(_interrupted, [1, 2, 3]) == [1, 2, 3]  # pool workers too
 
 
 class TestLocalInline(ExecutorContract):
