@@ -347,6 +347,34 @@ def test_sigterm_while_pool_workers_evaluate_ends_them_at_once(example_plugin, t
     assert _query(store, "select name from runs where status = 'RUNNING'") == []
 
 
+def test_ctrl_c_in_a_terminal_stops_the_run_and_its_pool_workers(example_plugin, template_db, tmp_path):
+    """A terminal's Ctrl-C signals the whole process group (driver and pool workers): the run stops
+    within seconds at its next safe point, exit 130, the run and both evaluations KILLED (resumable),
+    and the driver says where it stops."""
+    store = _new_store(template_db, tmp_path / "store")
+    proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", "task=quadratic", "search=random",
+                             "search.batch=2", "search.budget=2", "executor.workers=2", "task.sleep=30",
+                             f"store={store}"], env=jt_env(example_plugin), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,  # its own group, as a terminal's job
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        rid = _wait("the run's row", lambda: _outer_ids(store))[0]
+        _wait("both evaluations", lambda: len(_query(store, "select name from runs where status = 'RUNNING' and "
+                                                          "name like 'eval-%'")) == 2)
+        time.sleep(1.0)
+        t0 = time.monotonic()
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+    assert time.monotonic() - t0 < 15, "the run waited for its evaluations"
+    assert proc.returncode == 130 and _status(store, rid) == "KILLED", err
+    assert "stopping at the next safe point" in err and f"jt run resume={rid}" in err
+    assert _query(store, "select name from runs where status = 'RUNNING'") == []
+
+
 def test_the_handler_only_records_the_request_and_a_second_one_raises():
     from toolkit.execution import stopping
 
