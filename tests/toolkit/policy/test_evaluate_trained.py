@@ -55,3 +55,15 @@ def test_a_policy_of_another_task_is_one_line_before_a_run_opens(tmp_path):
         compose(["task=spacetime", "experiment=smoke", "action=raw", f"store={tmp_path}",
                  f"task.evaluate={trained.run_id}"])
     assert n_runs() == before  # no spacetime run row, not even a failed one
+
+
+def test_a_trained_policy_with_the_stores_own_prior_composes(tmp_path):
+    """``task.evaluate`` beside ``action.prior=auto`` (every ``experiment=laptop`` of a prior-based
+    task): the policy's fit is checked once the runner has found the prior, not at composition,
+    which refused it ("action.prior=auto is resolved by jt run")."""
+    from toolkit.config import compose
+
+    trained = _run(tmp_path)
+    cfg = compose(["task=runup", "experiment=smoke", f"store={tmp_path}", "action=pvae", "action.prior=auto",
+                   f"task.evaluate={trained.run_id}"])
+    assert str(cfg.action.prior) == "auto"
