@@ -93,7 +93,10 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
     if cfg.get("cost"):  # what the wait costs, before any work (a prior trained first included)
         _log(f"jt: cost: {cfg.cost}")
+    auto = auto_prior.wants_auto(cfg)
     cfg = auto_prior.resolve(cfg, _train_prior)  # action.prior=auto: the store's own prior, trained on first use
+    if auto:  # the task's checks that need the prior (a task.evaluate policy's fit), before the run opens
+        task_cls.check_run(cfg)
     store = open_store(store_root(str(cfg.store)))
     experiment = str(cfg.task.name)
     nested = bool(getattr(search_cls, "nested", True))

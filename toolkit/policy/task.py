@@ -49,7 +49,7 @@ def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
         store = str(group_of(action, "store") or "").strip() or group_of(cfg, "store")  # action.store first
         load_prior(prior, None if store is None else str(store), name)  # format, kind, shapes: one line each
     path = trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
-    if path is not None and prior != "auto":  # auto: checked once the runner has found the prior
+    if path is not None and prior != "auto":  # auto: checked again once the runner has found it
         check_policy_fits(cfg, task, path)
 
 
@@ -250,11 +250,9 @@ class PolicyTask(Task):
 
         from toolkit.rl.checkpoint import load, with_architecture
 
-        name = type(self).name or self.Config().name
-        src = trained_policy(self.cfg, name)
+        src = trained_policy(self.cfg, type(self).name or self.Config().name)
         if src is None:
             return None
-        check_policy_fits(self.cfg, name, src)  # again here: with action.prior=auto it could not be before
         dst = Path(workdir) / tr.CHECKPOINT
         if not dst.exists():  # copied whole, then renamed: a kill never leaves half a checkpoint
             tmp = dst.with_name(f"{dst.name}.tmp-{os.getpid()}")

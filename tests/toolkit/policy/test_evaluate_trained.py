@@ -67,3 +67,24 @@ def test_a_trained_policy_with_the_stores_own_prior_composes(tmp_path):
     cfg = compose(["task=runup", "experiment=smoke", f"store={tmp_path}", "action=pvae", "action.prior=auto",
                    f"task.evaluate={trained.run_id}"])
     assert str(cfg.action.prior) == "auto"
+
+
+def test_a_policy_that_does_not_fit_the_stores_own_prior_is_one_line_before_the_run_opens(tmp_path):
+    """With ``action.prior=auto`` the fit is checked once the runner has found (here: trained) the
+    prior, still before the run opens: a raw-action policy (28 actions) for P-VAE actions is one
+    ``JtError`` line and no run-up run row, not a FAILED run."""
+    from toolkit.config import compose
+    from toolkit.execution.runner import run
+
+    trained = _run(tmp_path)
+    client = trained.store.client
+    exp = client.get_experiment_by_name("runup")
+
+    def runup_runs():
+        return len(client.search_runs([exp.experiment_id]))
+
+    before = runup_runs()
+    with pytest.raises(JtError, match=r"task.evaluate=\w+: its policy takes \d+ observations and gives 28 actions"):
+        run(compose(["task=runup", "experiment=smoke", f"store={tmp_path}", "action=pvae", "action.prior=auto",
+                     f"task.evaluate={trained.run_id}"]))
+    assert runup_runs() == before
