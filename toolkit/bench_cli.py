@@ -13,11 +13,7 @@ from toolkit.errors import JtError
 
 bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks (speed is measured here, never in tests).")
 
-MODELS = ("humanoid", "laikago", "atlas", "snake36", "snake72", "snake195")
-BACKENDS = ("df", "sf", "pcg", "maba", "bullet")
-
-
-def _split(value: str, valid: tuple[str, ...], what: str) -> list[str]:
+def _split(value: str, valid: "tuple[str, ...] | list[str]", what: str) -> list[str]:
     items = [v.strip() for v in value.split(",") if v.strip()]
     bad = [v for v in items if v not in valid]
     if bad or not items:
@@ -43,8 +39,11 @@ def machine_info() -> dict:
 
 @bench_app.command("spd")
 def bench_spd(
-    models: str = typer.Option("humanoid,snake36,snake72,snake195", "--models", help=f"Comma list of {', '.join(MODELS)}."),
-    backends: str = typer.Option("df,sf,pcg,maba,bullet", "--backends", help=f"Comma list of {', '.join(BACKENDS)}."),
+    models: str = typer.Option("", "--models", help="Comma list of characters (the character config group); "
+                                                  "default: the simulator's benchmark set."),
+    backends: str = typer.Option("", "--backends", help="Comma list of installed SPD backends (jt plugins); "
+                                                      "default: the simulator's benchmark set."),
+    sim_name: str = typer.Option("", "--sim", help="Simulator plugin; default: the one installed."),
     samples: int = typer.Option(200, "--samples", help="Timed calls per (model, backend)."),
     seed: int = typer.Option(0, "--seed"),
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the results as JSON here."),
@@ -53,17 +52,22 @@ def bench_spd(
 ) -> None:
     """Time the SPD solve and the whole simulation step per model and backend (thesis Tables 2.2/2.3)."""
     from toolkit import plugins
+    from toolkit.config import group_options
+    from toolkit.quiet import preload_quietly
 
-    model_list = _split(models, MODELS, "model")
-    sim = plugins.load("sim", "bullet")  # the benchmark and its characters through the registry
-    bench, loader = sim.spd_bench(), sim.load_character
+    preload_quietly()  # no native banner among the rows
+    sim = plugins.load("sim", sim_name or plugins.sole("sim", "--sim"))  # the benchmark and its characters
+    bench, loader = getattr(sim, "spd_bench", lambda: None)(), sim.load_character
+    if bench is None:
+        raise JtError(f"sim={sim_name or sim.__name__} has no SPD benchmark (spd_bench)")
+    model_list = _split(models or ",".join(bench.MODELS), group_options("character"), "model")
     if check:
         worst = bench.check_agreement(model_list, n_states=20, seed=seed, loader=loader)
         typer.echo(f"largest relative torque difference between backends: {worst:.3e} (limit 1e-8)")
         if not worst <= 1e-8:
             raise typer.Exit(1)
         return
-    backend_list = _split(backends, BACKENDS, "backend")
+    backend_list = _split(backends or ",".join(bench.BACKENDS), plugins.names("spd"), "backend")
     rows = bench.time_spd(model_list, backend_list, n_samples=samples, seed=seed, loader=loader)
     header = f"{'model':<10} {'dof':>4} {'depth':>5} {'backend':<8} {'solve_us':>10} {'step_us':>10} {'share%':>7}"
     typer.echo(header)
@@ -131,10 +135,10 @@ def bench_rollout(
     overrides: Optional[List[str]] = typer.Argument(None, help="Hydra overrides added to every task's config "
                                                     "(e.g. agent.samples_per_iteration=1024), after the bench's own."),
     tasks: str = typer.Option("highjump", "--tasks", help="Comma list of policy tasks (their envs)."),
-    spd: str = typer.Option("task", "--spd", help=f"SPD backend: task (the task's own) or one of {', '.join(BACKENDS)}."),
+    spd: str = typer.Option("task", "--spd", help="SPD backend: task (the task's own) or an installed one (jt plugins)."),
     action: str = typer.Option("task", "--action",
-                               help="Action space: task (the task's own; one that needs a trained prior, pvae or "
-                                    "cvae, is replaced by raw) or an action group to use."),
+                               help="Action space: task (the task's own; one that needs a trained prior is "
+                                    "replaced by raw) or an action group to use."),
     rates: str = typer.Option("10,30", "--rates", help="Control rates (Hz) of the env measurement."),
     steps: int = typer.Option(400, "--steps", help="Timed control steps per rate."),
     collect_steps: int = typer.Option(256, "--collect-steps",
@@ -151,11 +155,12 @@ def bench_rollout(
 ) -> None:
     """Where a policy env's time goes per 600 Hz substep and per reset, PPO collection samples/s per
     worker, and training's samples/s with the PPO updates (as jt run trains)."""
+    from toolkit import plugins
     from toolkit.config import group_options
     from toolkit.rl.rollout_bench import check_policy_task, format_table, run_bench, task_overrides
 
-    if spd != "task" and len(_split(spd, BACKENDS, "backend")) != 1:
-        raise JtError(f"--spd takes one backend, got {spd!r}; choose from: task, {', '.join(BACKENDS)}")
+    if spd != "task" and len(_split(spd, plugins.names("spd"), "backend")) != 1:
+        raise JtError(f"--spd takes one backend, got {spd!r}; choose from: task, {', '.join(plugins.names('spd'))}")
     actions = group_options("action")
     if action != "task" and action not in actions:
         raise JtError(f"unknown --action '{action}'; choose from: task, {', '.join(actions)}")

@@ -13,7 +13,7 @@ import functools
 from importlib import metadata
 from typing import Any, Optional
 
-from toolkit.errors import BrokenPlugin, UnknownPlugin
+from toolkit.errors import BrokenPlugin, JtError, UnknownPlugin
 
 #: config group name → entry-point group. The config group of a kind has the kind's name.
 KINDS: dict[str, str] = {
@@ -89,6 +89,20 @@ def available(kind: str) -> list[PluginInfo]:
 def names(kind: str) -> list[str]:
     """Names of the plugins of ``kind``, sorted."""
     return [p.name for p in available(kind)]
+
+
+def sole(kind: str, what: str) -> str:
+    """The name of the one installed plugin of ``kind`` (e.g. the simulator when a hand-written
+    config names none); one ``JtError`` line naming the choices when there is not exactly one.
+
+    Args:
+        kind: a plugin kind (``sim``, ``spd`` ...).
+        what: the setting that picks one, for the message (e.g. ``sim.name``, ``--sim``).
+    """
+    found = names(kind)
+    if len(found) != 1:
+        raise JtError(f"{what} is not set; choose one of: {', '.join(found) or '(none installed)'}")
+    return found[0]
 
 
 @functools.lru_cache(maxsize=None)

@@ -38,21 +38,25 @@ def native_stderr_silenced() -> Iterator[None]:
             os.close(fd)
 
 
-#: Native modules that print a banner from C when first imported (PyBullet's ``pybullet build
-#: time: ...`` on stdout): names only, never imported here unless installed and asked for.
-NOISY_IMPORTS = ("pybullet",)
-
-
-def preload_quietly(names: tuple[str, ...] = NOISY_IMPORTS) -> None:
-    """Import each of ``names`` that is installed and not yet imported with C-level output silenced,
-    so that its banner never reaches a terminal (the CLI's working commands and every worker
-    process of the local executor call this first; later imports find the module loaded).
-    ``JT_VERBOSE_NATIVE=1`` shows the banners."""
+def preload_quietly() -> None:
+    """Import every installed simulator's noisy native modules (``Simulator.native_modules``, e.g.
+    PyBullet's ``pybullet build time: ...`` banner on stdout) with C-level output silenced, so that
+    no banner reaches a terminal: the CLI's working commands and every worker process of the local
+    executor call this first; later imports find the modules loaded. A broken simulator plugin is
+    left to the command that uses it. ``JT_VERBOSE_NATIVE=1`` shows the banners."""
     import importlib
     import importlib.util
 
-    for name in names:
-        if name in sys.modules or importlib.util.find_spec(name) is None:
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    for sim in plugins.names("sim"):
+        try:
+            names = tuple(getattr(plugins.load("sim", sim), "native_modules", ()))
+        except JtError:
             continue
-        with native_stderr_silenced():
-            importlib.import_module(name)
+        for name in names:
+            if name in sys.modules or importlib.util.find_spec(name) is None:
+                continue
+            with native_stderr_silenced():
+                importlib.import_module(name)

@@ -27,6 +27,7 @@ class PVAEActionSpace(DofActionSpace):
     """Action = [P-VAE latent, per-DoF offsets]; target = decode(latent) + offset (000 §4.2)."""
 
     kind = "pvae"
+    needs_prior = True
 
     @dataclasses.dataclass
     class Config(FilterCheck):

@@ -26,7 +26,8 @@ from jt_bullet.model import model_from_bullet
 from toolkit.dynamics.model import Data, Model
 from toolkit.dynamics.spd import METHODS, spd_solve
 
-BACKENDS = METHODS + ("bullet",)
+BACKENDS = METHODS + ("bullet",)  #: ``jt bench spd``'s default backends (servo is opt-in: no solve to time)
+MODELS = ("humanoid", "snake36", "snake72", "snake195")  #: ``jt bench spd``'s default characters (thesis Table 2.1)
 SOLVE_BLOCK = 10  #: consecutive solves per backend before switching (keeps caches warm)
 
 

@@ -47,6 +47,7 @@ class BulletSimulator(SceneQueries, Simulator):
 
     Config: ClassVar[type] = SimConfig
     group_schemas: ClassVar[dict[str, type]] = {"character": CharacterConfig}
+    native_modules: ClassVar[tuple[str, ...]] = ("pybullet",)  #: its build banner, silenced by toolkit.quiet
 
     def __init__(self, cfg: Any) -> None:
         import pybullet as pb

@@ -87,3 +87,75 @@ def test_the_source_check_sees_an_import():
     text = "def f():\n    import pybullet as pb\n    from jt_bullet.characters import load\n"
     assert len(pattern.findall(text)) == 2
     assert not pattern.search("x = 1  # from pybullet_data's clips\nimport pybullet_data\n")
+
+
+# ---------------------------------------------------------------- names in code (issue 54)
+
+#: Where ``toolkit/`` may still name a plugin in code, and why: the core's own algorithms and file
+#: formats share a plugin's name, a benchmark's documented default, the shared suites' reference
+#: task. Anything else is a plugin name the core should have asked the registry or the config for.
+ALLOWED = {
+    "toolkit/dynamics/spd.py": {"maba", "df", "sf", "pcg"},  # the core's SPD algorithms (jt_spd wraps them)
+    "toolkit/priors/io.py": {"pvae", "pose_prior"},  # a prior file's kind (the P-VAE / C-VAE formats are
+    # core), and the command that trains one in its messages
+    "toolkit/priors/model.py": {"pvae", "cvae"},
+    "toolkit/priors/train.py": {"cvae"},
+    "toolkit/priors/vae.py": {"pvae", "cvae"},
+    "toolkit/policy/task.py": {"raw"},  # "(or use action=raw)": the fix a missing prior's message offers
+    "toolkit/bench_cli.py": {"highjump"},  # jt bench rollout's documented default task (--tasks)
+    "toolkit/rl/rollout_bench.py": {"raw", "local"},  # the benchmark's fallback actions, its process pool
+    "toolkit/rl/sanity.py": {"local"},  # jt bench ppo's process pool
+    "toolkit/testing/curriculum.py": {"zdt1"},  # the shared suites' reference task
+    "toolkit/testing/executor.py": {"zdt1"},
+    "toolkit/testing/spd.py": {"df"},  # the shared SPD suite's reference backend
+}
+
+
+def plugin_names() -> set[str]:
+    """Every plugin name jt registers (``bullet``, ``maba``, ``pvae``, ``highjump`` ...)."""
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    return {name for group, eps in meta["project"].get("entry-points", {}).items()
+            if group.startswith("jt.") and group != "jt.config" for name in eps}
+
+
+def named_plugins(text: str, names: set[str]) -> set[str]:
+    """Plugin names in ``text``'s string literals (docstrings left out): a literal that is a name,
+    or a short one with a name as a word (``"action=raw"``, ``"df,sf"``)."""
+    import ast
+
+    tree = ast.parse(text)
+    docs = {id(n.body[0].value) for n in ast.walk(tree)
+            if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+            and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
+            words = set(re.split(r"[\s,=()\[\]:;]+", node.value))
+            found |= {node.value} & names if len(node.value) >= 80 else words & names
+    return found
+
+
+def test_no_toolkit_code_names_a_plugin():
+    """Lists of backends, the simulator, the character, the prior-needing action spaces and a
+    task's cheap settings come from the registry, the config or the plugin itself (issue 54)."""
+    names = plugin_names()
+    hits = {}
+    for p in sorted(TOOLKIT.rglob("*.py")):
+        rel = str(p.relative_to(ROOT))
+        extra = named_plugins(p.read_text(), names) - ALLOWED.get(rel, set())
+        if extra:
+            hits[rel] = sorted(extra)
+    assert not hits, hits
+
+
+def test_the_allowed_names_are_still_there():
+    """An allowance the code no longer needs is removed (so the list stays the truth)."""
+    names = plugin_names()
+    stale = {rel: sorted(allowed - named_plugins((ROOT / rel).read_text(), names))
+             for rel, allowed in ALLOWED.items()}
+    assert not {k: v for k, v in stale.items() if v}, stale
+
+
+def test_the_name_check_sees_a_name():
+    text = 'def f():\n    """Uses bullet."""\n    return load("sim", "bullet"), "action=raw", "x = 1"\n'
+    assert named_plugins(text, {"bullet", "raw", "maba"}) == {"bullet", "raw"}

@@ -37,6 +37,9 @@ class ActionSpace(GroupPlugin, abc.ABC):
     #: (``set_condition``), ``"phase"`` (``set_phase``); checked at composition against
     #: ``Task.action_inputs`` where a task declares them
     needs: ClassVar[frozenset[str]] = frozenset()
+    #: True for a space that decodes through a trained prior (``action.prior``): a task checks
+    #: one is named before a run opens, and ``jt bench rollout`` swaps in ``action=raw`` for it
+    needs_prior: ClassVar[bool] = False
 
     skeleton: Any = None
     filtered: Any = None

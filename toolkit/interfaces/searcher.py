@@ -138,9 +138,10 @@ class Searcher(Plugin, abc.ABC):
             from toolkit.errors import JtError
 
             name = getattr(type(self), "name", "") or type(self).__name__
+            able = ", ".join(f"search={n}" for n in _honouring_searchers()) or "none installed"
             raise JtError(f"search={name} cannot keep to the task's constraint "
                           f"({problem.constraint_name or 'SearchProblem.constraint'}): unset it or use a searcher "
-                          "that honours it (search=bds, search=random)")
+                          f"that honours it ({able})")
         self.problem = problem
         self.cfg = cfg
         self.seed = seed
@@ -174,3 +175,18 @@ class Searcher(Plugin, abc.ABC):
     def summary(self) -> dict[str, Any]:
         """Arrays describing the search state (GP data, fronts, ...) for the outer run's HDF5."""
         return {}
+
+
+def _honouring_searchers() -> list[str]:
+    """The installed searchers that keep to a task's constraint (``honours_constraint``)."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    out = []
+    for name in plugins.names("search"):
+        try:
+            if getattr(plugins.load("search", name), "honours_constraint", False):
+                out.append(name)
+        except JtError:  # a broken plugin is reported where it is used
+            continue
+    return out

@@ -102,6 +102,9 @@ class Simulator(Plugin, abc.ABC):
         render_poses: optional classmethod ``render_poses(skeleton, dofs) -> list`` of RGB frames
             ``(height, width, 3)`` uint8 of still poses in the dof layout ``(n, n_dof)`` (the
             priors' filmstrips, ``toolkit.priors.render``).
+        native_modules: names of native modules the simulator imports that print from C when
+            first imported (a build banner): ``toolkit.quiet.preload_quietly`` imports them with
+            C-level output silenced before a command or a worker starts. Empty by default.
 
     Required: ``sim_hz``, ``control_hz``, ``reset``, ``step``, ``state`` and the queries and scene methods below that a task
     uses (the defaults raise ``NotImplementedError``); ``close`` releases the engine.
@@ -119,6 +122,7 @@ class Simulator(Plugin, abc.ABC):
     forward_kinematics: ClassVar[Optional[Callable[..., Any]]] = None
     kinematic_body: ClassVar[Optional[Callable[..., Any]]] = None
     render_poses: ClassVar[Optional[Callable[..., Any]]] = None
+    native_modules: ClassVar[tuple[str, ...]] = ()
     group_schemas: ClassVar[dict[str, type]] = {}
 
     def __init__(self, cfg: Any) -> None:

@@ -36,7 +36,7 @@ def load_simulator(sim: dict) -> Any:
 
     cfg = OmegaConf.create(dict(sim))
     cfg.sim = OmegaConf.merge(cfg.get("sim") or {}, {"contacts": False})
-    name = str(cfg.sim.get("name") or "bullet")
+    name = str(cfg.sim.get("name") or "") or plugins.sole("sim", "sim.name")  # a hand-written spec: the one installed
     return plugins.load("sim", name)(cfg)
 
 
@@ -73,7 +73,8 @@ class CharacterEnv(gymnasium.Env):
         self.n_links = int(self.sim.n_links)
         self.masses = np.asarray(self.sim.masses)
         action = dict(spec.action)
-        self.action_space_ = plugins.load("action", str(action["name"]))(action, "humanoid")
+        character = (dict(spec.sim).get("character") or {}).get("name")  # None: the action space's default
+        self.action_space_ = plugins.load("action", str(action["name"]))(action, character)
         self.skeleton = self.action_space_.skeleton
         low, high = self.action_space_.bounds()
         scale = getattr(self.action_space_, "output_scale", None)

@@ -29,18 +29,24 @@ from toolkit.interfaces.task import EvalContext, Evaluation, Task
 from toolkit.policy import train as tr
 
 
-def require_humanoid_and_prior(cfg: Any, task: str, why: str) -> None:
-    """For ``Task.check_run``: ``character=humanoid`` (``why`` says what the task takes from its
-    clips) and, for ``action=pvae|cvae``, a trained prior; one ``JtError`` line each."""
-    from toolkit.errors import JtError
+def require_character_and_prior(cfg: Any, task: str, character: str, why: str) -> None:
+    """For ``Task.check_run``: ``character=<character>`` (``why`` says what the task takes from
+    it) and, for an action space that decodes through a trained prior (``needs_prior``), a prior
+    named; one ``JtError`` line each."""
+    from toolkit import plugins
+    from toolkit.errors import JtError, UnknownPlugin
 
-    character = str(group_of(group_of(cfg, "character") or {}, "name") or "humanoid")
-    if character != "humanoid":
-        raise JtError(f"task={task} needs character=humanoid ({why}), got character={character}")
+    got = str(group_of(group_of(cfg, "character") or {}, "name") or "")
+    if got != character:
+        raise JtError(f"task={task} needs character={character} ({why}), got character={got or '(none)'}")
     action = group_of(cfg, "action")
     name = str(group_of(action, "name") or "") if action is not None else ""
-    prior = str(group_of(action, "prior") or "").strip() if name in ("pvae", "cvae") else ""
-    if name in ("pvae", "cvae") and not prior:
+    try:
+        needs_prior = bool(name) and bool(getattr(plugins.load("action", name), "needs_prior", False))
+    except UnknownPlugin:  # composition names the valid action spaces
+        needs_prior = False
+    prior = str(group_of(action, "prior") or "").strip() if needs_prior else ""
+    if needs_prior and not prior:
         raise JtError(f"action={name} needs a trained prior: action.prior=<run id | folder | prior.h5>; "
                       f"train one with: jt run task=pose_prior action={name} (or use action=raw)")
     if prior and prior != "auto":  # read and checked before the run opens (auto: found or trained by the runner)
@@ -137,6 +143,10 @@ class PolicyTask(Task):
 
     env_path: ClassVar[str] = ""
     """``module:Class`` of the task's ``CharacterEnv`` (imported when first needed)."""
+    cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0"}
+    """``task.<key>`` values that make the part of an evaluation after training cheap (no
+    filmstrip, fewer or shorter measuring episodes) without changing what training does: the
+    training benchmark (``jt bench rollout --train``) runs with them."""
 
     def __init__(self, cfg: Any = None) -> None:
         if cfg is None:

@@ -52,7 +52,7 @@ class PPOConfig:
     target_kl: Optional[float] = None
     """Stop an iteration's epochs once an epoch's mean approximate KL exceeds this (CleanRL's
     ``target_kl``); None: always ``epochs`` (the paper). Guards large-step settings (Adam, wide
-    clip) against the overshoots docs/highjump.md shows."""
+    clip) against the overshoots docs/journal/jumping.md shows."""
     policy_lr: float = 2.5e-5
     """Policy learning rate (000 §6.2)."""
     value_lr: float = 1.0e-2

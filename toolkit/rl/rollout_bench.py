@@ -35,7 +35,6 @@ from typing import Any, Callable, Optional, Sequence
 import numpy as np
 
 PAPER_SAMPLES_PER_CORE = 1.0e8 / (6 * 3600) / 48  #: 000 §6.2: ~1e8 samples, ~6 h, 48 cores
-PRIOR_ACTIONS = ("pvae", "cvae")  #: action spaces that need a trained prior (replaced by raw unless asked for)
 EPISODE_LENGTHS = (5, 600)  #: control steps per episode a reset's cost is spread over (reset_us_per_sample_L*)
 UPDATE_SHARE_NOTE = 0.25  #: an update share above this is said in the table
 
@@ -102,7 +101,7 @@ def task_overrides(task: str, action: str = "task", spd: str = "task",
     own_action = str(group_of(group_of(cfg, "action") or {}, "name") or "")
     asked = action != "task" or any(o.startswith("action=") for o in extra)
     note = ""
-    if not asked and own_action in PRIOR_ACTIONS:
+    if not asked and own_action and _needs_prior(own_action):
         over.insert(0, "action=raw")
         note = f"({own_action} needs a prior)"
         cfg = compose([f"task={task}", *over])
@@ -112,6 +111,14 @@ def task_overrides(task: str, action: str = "task", spd: str = "task",
     words = [f"task={task}"] + [f"{o} {note}" if o == "action=raw" and note else o for o in over]
     header = " ".join(words) + (f" (task's own: {', '.join(own)})" if own else "")
     return over, header
+
+
+def _needs_prior(action: str) -> bool:
+    """The action space decodes through a trained prior (its ``needs_prior``): the benchmark then
+    measures ``action=raw`` unless an action space is asked for."""
+    from toolkit import plugins
+
+    return bool(getattr(plugins.load("action", action), "needs_prior", False))
 
 
 def _set_control_rate(env: Any, hz: float) -> bool:

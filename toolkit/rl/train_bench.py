@@ -14,16 +14,14 @@ import numpy as np
 
 
 def cheap_overrides(cfg: Any) -> list[str]:
-    """Overrides that keep the part of a policy task's evaluation that is not training cheap, for
-    the keys its ``task`` group has: no filmstrip or GIF (``filmstrip_frames=0``), one
-    deterministic evaluation episode (``eval_episodes``), no periodic evaluation during training
-    (``eval_every``, spacetime), a 1 s final evaluation (``eval_time_limit``, spacetime) and no
-    Table 1 evaluation (``eval_regions=[]``, getup). None of them changes what training does."""
+    """The task's own ``cheap_evaluation`` (``PolicyTask``) as overrides, for the keys its ``task``
+    group has: they make what follows training cheap (no filmstrip, fewer or shorter measuring
+    episodes) and change nothing that training does."""
+    from toolkit import plugins
     from toolkit.config import group_of
 
     task = group_of(cfg, "task") or {}
-    wanted = {"filmstrip_frames": "0", "eval_episodes": "1", "eval_every": str(10 ** 9),
-              "eval_time_limit": "1.0", "eval_regions": "[]"}
+    wanted = getattr(plugins.load("task", str(group_of(task, "name"))), "cheap_evaluation", {})
     return [f"task.{k}={v}" for k, v in wanted.items() if k in task]
 
 

@@ -25,7 +25,7 @@ from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.getup.config import GetupConfig
 from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
-from toolkit.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
+from toolkit.policy.task import Hooks, PolicyTask, require_character_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
 #: per-iteration means over episodes from the ground (clip first poses and rag-doll states; not
@@ -47,11 +47,14 @@ class GetupTask(PolicyTask):
         "link_ang_vel", "joint_rotations", "neutral_rotations", "naturalness"})
     action_inputs: ClassVar[frozenset[str]] = frozenset({"condition"})
     curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"terrain_level"})
+    #: one deterministic episode, no periodic evaluation, no Table 1 evaluation (a benchmark's)
+    cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0", "eval_episodes": "1",
+                                                  "eval_every": str(10 ** 9), "eval_regions": "[]"}
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:
         """The humanoid (the curves and start poses come from its clips) and a prior for action=cvae/pvae."""
-        require_humanoid_and_prior(cfg, "getup", "its curves and start poses come from the DeepMimic "
+        require_character_and_prior(cfg, "getup", "humanoid", "its curves and start poses come from the DeepMimic "
                                                "humanoid's get-up clips")
         from toolkit.errors import JtError
 

@@ -50,7 +50,7 @@ class JumpConfig(PolicyConfig):
     root to the bar plane within this time (``distance / v_n <= t``, ``v_n`` the speed along the
     bar's normal, set by alpha and v_z): a known constraint that bds and random keep to, rmoo and
     bsoo refuse and single ignores (it evaluates its given point) (ours; 000 gives no search box;
-    docs/highjump.md "The laptop run"). null: the whole box (the paper)."""
+    docs/highjump.md "Deviations from the paper"). null: the whole box (the paper)."""
     obstacle_height: float = 0.5
     """m, the obstacle jump's box (000 §6.1: 50 cm); unused by the high jump; 0: the long jump."""
     mat_height: float = 0.3

@@ -11,7 +11,7 @@ and the root, ``distance`` before the plane, needs ``distance / v_n`` to reach i
 CoM's horizontal velocity cannot change, so a state with a small ``v_n`` runs along the bar and
 comes down before it crosses: no policy gives it a feature. ``BarReach`` is that known constraint,
 ``margin = v_n - distance / t_max >= 0``, for the searchers (``SearchProblem.constraint``). Ours:
-``000`` gives no search box; docs/highjump.md "The laptop run" has the measurements behind it.
+``000`` gives no search box; docs/journal/jumping.md has the measurements behind it.
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.jumping.config import JumpConfig, LongJumpConfig, ObstacleConfig
-from toolkit.policy.task import PolicyTask, require_humanoid_and_prior
+from toolkit.policy.task import PolicyTask, require_character_and_prior
 
 
 def require_own_control_rate(cfg: Any, task: str) -> None:
@@ -65,7 +65,7 @@ class JumpTask(PolicyTask):
         """The jumps need the humanoid (their take-off states come from its clips) and, for the
         P-VAE / C-VAE action spaces, a trained prior; their control rate is the curriculum's, so a
         ``sim.control_hz`` other than the simulator's default is refused, not ignored."""
-        require_humanoid_and_prior(cfg, cls.Config().name, "its take-off states come from the DeepMimic humanoid's clips")
+        require_character_and_prior(cfg, cls.Config().name, "humanoid", "its take-off states come from the DeepMimic humanoid's clips")
         require_own_control_rate(cfg, cls.Config().name)
 
     def __init__(self, cfg: Any = None) -> None:

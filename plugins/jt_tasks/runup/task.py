@@ -23,7 +23,7 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from toolkit.policy.history import IterationHistory, base_metrics, finite, numbers
-from toolkit.policy.task import Hooks, PolicyTask, require_humanoid_and_prior
+from toolkit.policy.task import Hooks, PolicyTask, require_character_and_prior
 
 from jt_tasks.runup.config import RunupConfig
 
@@ -56,7 +56,7 @@ class RunupTask(PolicyTask):
     def check_run(cls, cfg: Any) -> None:
         """The run-up imitates the DeepMimic humanoid's run: character=humanoid (and a prior for
         the VAE action spaces)."""
-        require_humanoid_and_prior(cfg, "runup", "it imitates the DeepMimic humanoid's run")
+        require_character_and_prior(cfg, "runup", "humanoid", "it imitates the DeepMimic humanoid's run")
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)

@@ -40,13 +40,16 @@ class SpacetimeTask(PolicyTask):
     #: its rewards are task.style's terms and the bounds; no curriculum drives it
     ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum")
     action_inputs: ClassVar[frozenset[str]] = frozenset({"phase"})  #: the reference clip's phase
+    #: no periodic Table 1 evaluation, a 1 s final one (a benchmark's)
+    cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0", "eval_every": str(10 ** 9),
+                                                  "eval_time_limit": "1.0"}
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:
         """The humanoid: its bounds, channels and reference clips are the DeepMimic humanoid's."""
-        from toolkit.policy.task import require_humanoid_and_prior
+        from toolkit.policy.task import require_character_and_prior
 
-        require_humanoid_and_prior(cfg, "spacetime", "its bounds and reference clips are the DeepMimic humanoid's")
+        require_character_and_prior(cfg, "spacetime", "humanoid", "its bounds and reference clips are the DeepMimic humanoid's")
 
     def __init__(self, cfg: Any = None) -> None:
         super().__init__(cfg)
