@@ -79,7 +79,7 @@ def test_a_standing_start_is_the_chosen_pose(envs):
 
 
 def test_one_sagittal_ankle_law_keeps_the_symmetric_stance_up_and_not_the_clips_frame(envs):
-    """Why the clip's frame is hard to stand in (docs/getup.md, "Why a held standing pose falls"):
+    """Why the clip's frame is hard to stand in (docs/journal/getup.md, "Why a held standing pose falls"):
     held by PD both fall within 2 s; with the ankles pitched on the CoM's forward offset and speed,
     the symmetric stance stands 5 s and the clip's frame (its legs unlike, one sole tilted) still falls
     within 2 s, sideways."""
@@ -91,7 +91,7 @@ def test_one_sagittal_ankle_law_keeps_the_symmetric_stance_up_and_not_the_clips_
 
 
 def test_constraint_servos_hold_the_symmetric_stance_where_stable_pd_lets_it_fall(envs):
-    """Why SPD cannot hold a stance (docs/getup.md, "Servos solved with the contacts"): Stable PD
+    """Why SPD cannot hold a stance (docs/journal/getup.md, "Stable PD's planted ankle, and servos solved with the contacts"): Stable PD
     predicts a planted foot's acceleration from its own tiny inertia, so the ankle's torque is a
     small share of its gain's. ``spd=servo`` (PyBullet's constraint motors, solved with the contacts)
     holds the symmetric stance 5 s with no feedback at all, also from perturbed starts; the clip's

@@ -39,7 +39,7 @@ def test_speed_and_distance_are_the_scenes(point):
 
 
 def test_the_laptop_runs_states_fall_on_the_side_they_were_measured():
-    """Two laptop runs (docs/highjump.md): the states that crossed reach the plane within 0.45 s,
+    """Two laptop runs (docs/journal/jumping.md): the states that crossed reach the plane within 0.45 s,
     the ones at 0.75 s and 2.5 s mostly did not cross; the laptop preset's 0.55 s keeps the first, drops the second
     and keeps every take-off state of 000 Table 3."""
     from toolkit import plugins
