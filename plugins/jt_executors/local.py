@@ -81,10 +81,12 @@ def _die_with_parent(parent_pid: Optional[int], pdeathsig: bool) -> None:
 
 
 def _ignore_ctrl_c() -> None:
-    """A terminal's Ctrl-C reaches every process of its group: a worker ignores it and the driver
-    decides (it stops the run at its next safe point and ends the workers, ``toolkit.execution.
-    stopping``); a worker killed by it mid-call would turn a KILLED, resumable run into a FAILED one."""
+    """A terminal's Ctrl-C, and its hang-up when the window closes, reach every process of its
+    group: a worker ignores them and the driver decides (it stops the run at its next safe point
+    and ends the workers, ``toolkit.execution.stopping``); a worker killed by one mid-call would
+    turn a KILLED, resumable run into a FAILED one."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
 
 
 def _worker_init(parent_pid: Optional[int], pdeathsig: bool) -> None:

@@ -10,6 +10,11 @@ while the local executor waits for its workers. ``check()`` raises ``KeyboardInt
 reason, which the runner turns into a KILLED run (exit 130, resumable). A second SIGTERM while
 the first is pending raises at once (a run stuck somewhere can still be stopped).
 
+SIGHUP (the terminal closed: a window shut, an ssh session dropped) is a stop request like SIGTERM;
+since the terminal is gone, the process's stdout and stderr are pointed at /dev/null first, so
+the lines said while stopping cannot fail on a dead terminal. Where SIGHUP is ignored (``nohup``)
+it stays ignored.
+
 Ctrl-C (SIGINT) is handled the same way while a run is open: Python's own handler raises
 ``KeyboardInterrupt`` wherever the main thread is, and one that lands in a weakref callback or a
 ``__del__`` is printed and swallowed, so the run went on to FINISHED. The first Ctrl-C now asks for
@@ -59,6 +64,7 @@ class Terminate:
 
     REASON = "terminated (SIGTERM)"
     REASON_INT = "interrupted (Ctrl-C)"
+    REASON_HUP = "hung up (SIGHUP: the terminal closed)"
     _depth = 0  #: open Terminate blocks (a comparison's cells run inside its own)
 
     def __enter__(self) -> "Terminate":
@@ -68,17 +74,21 @@ class Terminate:
         self._old: dict[int, Any] = {}
 
         def handler(signum: int, frame: Any) -> None:
-            reason = self.REASON_INT if signum == signal.SIGINT else self.REASON
+            reason = {signal.SIGINT: self.REASON_INT, signal.SIGHUP: self.REASON_HUP}.get(signum, self.REASON)
+            if signum == signal.SIGHUP:
+                _detach_from_terminal()
             if requested() is not None:
                 raise KeyboardInterrupt(reason)
             request(reason)
             if signum == signal.SIGINT:  # os.write: no buffered I/O inside a signal handler
                 os.write(2, b"\njt: stopping at the next safe point (Ctrl-C again to stop now)\n")
 
-        for sig in (signal.SIGTERM, signal.SIGINT):
+        for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
             old = signal.getsignal(sig)
             if sig == signal.SIGINT and old is not signal.default_int_handler:
                 continue  # ignored (a background job) or someone else's: left as it is
+            if sig == signal.SIGHUP and old is not signal.SIG_DFL:
+                continue  # ignored (nohup) or someone else's: left as it is
             try:
                 signal.signal(sig, handler)
             except ValueError:  # not the main thread
@@ -92,3 +102,18 @@ class Terminate:
             signal.signal(sig, old)
         if Terminate._depth == 0:
             clear()
+
+
+def _detach_from_terminal() -> None:
+    """Point file descriptors 1 and 2 at /dev/null (the terminal that had them is gone: a write
+    would fail with EIO and break the stop's own lines)."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+    except OSError:
+        return
+    for fd in (1, 2):
+        try:
+            os.dup2(null, fd)
+        except OSError:
+            pass
+    os.close(null)

@@ -109,27 +109,57 @@ class Store:
 
         try:
             with _locked(self.root):
-                self.client = MlflowClient(tracking_uri=self.uri)
-                self.client.search_experiments(max_results=1)  # creates/migrates the schema under the lock
-                self._default_inside()
+                self._open_database(MlflowClient)
         except OSError as e:
             raise JtError(f"store={self.root}: cannot write there ({e.strerror or e}); "
                           "give a folder you can write to, or an MLflow server URI http://host:port") from e
         except Exception as e:  # noqa: BLE001 - MLflow / SQLAlchemy raise many types for a bad database
-            if "sqlite" in type(e).__module__.lower() or "sqlalchemy" in type(e).__module__.lower() \
+            if any(m in type(e).__module__.lower() for m in ("sqlite", "sqlalchemy", "alembic")) \
                     or "MlflowException" in type(e).__name__:
                 raise JtError(f"store={self.root}: its mlflow.db is not a usable MLflow database "
                               f"({str(e).splitlines()[0][:120]}); move it away to start a new store "
                               "there, or give another store=") from e
             raise
 
-    def _default_inside(self) -> None:
+    def _open_database(self, client_class: Any) -> None:
+        """Under the store's lock: build a new database where no signal can leave it half-built
+        (``toolkit.store.creation``), rebuild one that an interrupted first run left half-migrated
+        (it holds no run), and open the client."""
+        from toolkit.store import creation
+
+        db = self.root / creation.DB
+        creation.remove_partials(self.root)
+        if creation.needs_building(db):
+            creation.build(self.root, self._migrate)
+        try:
+            self.client = client_class(tracking_uri=self.uri)
+            self.client.search_experiments(max_results=1)  # an older store's migrations, under the lock
+        except Exception:  # noqa: BLE001 - MLflow / SQLAlchemy raise many types for a bad database
+            if not creation.never_held_a_run(db):
+                raise
+            _dispose(self.uri)
+            db.unlink()
+            creation.build(self.root, self._migrate)
+            self.client = client_class(tracking_uri=self.uri)
+            self.client.search_experiments(max_results=1)
+        self._default_inside(db)
+
+    def _migrate(self, uri: str) -> None:
+        """Create and migrate MLflow's schema in the database at ``uri``, point its Default
+        experiment into the store, and release every connection to it."""
+        from mlflow.tracking import MlflowClient
+
+        MlflowClient(tracking_uri=uri).search_experiments(max_results=1)
+        _dispose(uri)
+        self._default_inside(Path(uri[len("sqlite:///"):]))
+
+    def _default_inside(self, db: Path) -> None:
         """Point MLflow's "Default" experiment (id 0) into the store: MLflow creates it with the
         artifact location ``<cwd>/mlruns/0``, outside the store (and MLflow has no call to move it)."""
         import sqlite3
 
         inside = str(self.root / "runs" / "Default")
-        con = sqlite3.connect(self.root / "mlflow.db", timeout=30)
+        con = sqlite3.connect(db, timeout=30)
         try:
             with con:
                 con.execute("UPDATE experiments SET artifact_location = ? WHERE experiment_id = 0 "
@@ -262,6 +292,23 @@ class Store:
     def metrics(self, run_id: str) -> "MetricBuffer":
         """A metric buffer for ``run_id`` (flush it, or use it as a context manager)."""
         return MetricBuffer(self, run_id)
+
+
+def _dispose(uri: str) -> None:
+    """Close and forget the engine MLflow keeps for the SQLite database at ``uri`` (its SQLAlchemy
+    store caches one per URI, with pooled connections), so the file can be renamed or replaced and
+    a later client opens the new one."""
+    try:
+        from mlflow.store.tracking.sqlalchemy_store import SqlAlchemyStore
+
+        engines = SqlAlchemyStore._engine_map
+        lock = SqlAlchemyStore._engine_map_lock
+    except (ImportError, AttributeError):  # a private API: without it the pool closes at exit
+        return
+    with lock:
+        engine = engines.pop(uri, None)
+    if engine is not None:
+        engine.dispose()
 
 
 def _is_preview(path: Path) -> bool:

@@ -375,6 +375,56 @@ def test_ctrl_c_in_a_terminal_stops_the_run_and_its_pool_workers(example_plugin,
     assert _query(store, "select name from runs where status = 'RUNNING'") == []
 
 
+def test_closing_the_terminal_stops_the_run_at_a_safe_point(example_plugin, template_db, tmp_path):
+    """SIGHUP to the whole group (a closed window, a dropped ssh session) with the terminal gone
+    (the pipes closed: every write would fail): the run stops like after SIGTERM, exit 130, the
+    run and its evaluations KILLED and resumable, the workers left to the driver."""
+    store = _new_store(template_db, tmp_path / "store")
+    proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", "task=quadratic", "search=random",
+                             "search.batch=2", "search.budget=2", "executor.workers=2", "task.sleep=30",
+                             f"store={store}"], env=jt_env(example_plugin), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        rid = _wait("the run's row", lambda: _outer_ids(store))[0]
+        _wait("both evaluations", lambda: len(_query(store, "select name from runs where status = 'RUNNING' and "
+                                                          "name like 'eval-%'")) == 2)
+        time.sleep(1.0)
+        proc.stdout.close()
+        proc.stderr.close()
+        t0 = time.monotonic()
+        os.killpg(proc.pid, signal.SIGHUP)
+        proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert time.monotonic() - t0 < 15, "the run waited for its evaluations"
+    assert proc.returncode == 130 and _status(store, rid) == "KILLED"
+    assert _query(store, "select name from runs where status = 'RUNNING'") == []
+
+
+def test_sighup_is_a_request_unless_it_is_ignored():
+    from toolkit.execution import stopping
+
+    with stopping.Terminate():
+        saved = os.dup(1), os.dup(2)
+        try:
+            os.kill(os.getpid(), signal.SIGHUP)
+            assert stopping.requested() == stopping.Terminate.REASON_HUP
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+    assert signal.getsignal(signal.SIGHUP) is signal.SIG_DFL
+    old = signal.signal(signal.SIGHUP, signal.SIG_IGN)  # nohup
+    try:
+        with stopping.Terminate():
+            assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, old)
+
+
 def test_the_handler_only_records_the_request_and_a_second_one_raises():
     from toolkit.execution import stopping
 
