@@ -1,10 +1,11 @@
-"""An env's spec derived from its task's ``Config``: every shared value is declared once.
+"""An env's spec derived from its task's ``Config``: every setting is declared once.
 
-A policy task's env runs in rollout workers from a plain, picklable ``*Spec`` dataclass. The
-fields a spec shares by name with the task's ``Config`` are copied by ``spec_of`` — not by a hand
-copy per field — and a spec declares a shared field's default as the ``Config``'s
-(``default_of``), so a value the user sets in ``task.*`` reaches the env through one mechanism and
-a default cannot differ between the two (``tests/toolkit/policy/test_spec.py``).
+A policy task's env runs in rollout workers from a plain, picklable ``*Spec`` dataclass that
+subclasses the task's ``Config``: it inherits every ``task.*`` setting (with its default and
+source) and adds the values the task resolves from them (the sim and action groups, curves, bound
+widths ...). ``spec_of`` copies the settings from the task's typed parameters, so a value the user
+sets reaches the env through one mechanism, and adding a setting is one field in the ``Config``
+(``tests/toolkit/policy/test_spec.py``).
 """
 
 from __future__ import annotations
@@ -12,19 +13,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 from typing import Any
-
-
-def default_of(config_cls: type, name: str) -> Any:
-    """A ``dataclasses.field`` with the default that ``config_cls`` declares for ``name``.
-
-    Args:
-        config_cls: a task's ``Config`` dataclass.
-        name: one of its fields.
-    """
-    f = {f.name: f for f in dataclasses.fields(config_cls)}[name]
-    if f.default_factory is not dataclasses.MISSING:
-        return dataclasses.field(default_factory=f.default_factory)
-    return dataclasses.field(default=f.default)
 
 
 def shared_fields(spec_cls: type, config_cls: type) -> list[str]:

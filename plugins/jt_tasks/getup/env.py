@@ -38,7 +38,6 @@ from jt_tasks.getup.ground import lift_to_ground
 from jt_tasks.getup.initial import clip_pose, clip_state_at, perturb_joints, pick_curve, symmetric_legs
 from jt_tasks.getup.terrain import TerrainSpec, add_terrain, orient_feet, place_on_ground, sample_locations
 from toolkit.policy.env import CharacterEnv
-from toolkit.policy.spec import default_of
 from toolkit.interfaces.simulator import Watch
 from toolkit.motion import rotations as rot
 
@@ -47,30 +46,14 @@ LOOKAHEAD = np.array([0.0, 0.1, 0.2, 0.3])  #: s, curve targets in the state (00
 
 
 @dataclasses.dataclass
-class GetupSpec:
-    """Everything a get-up environment needs, as plain picklable data. A field named as one of
-    ``GetupConfig``'s has its default from there (``GetupConfig`` documents it); the rest are
-    the task's resolved values (``toolkit.policy.spec``)."""
+class GetupSpec(_C):
+    """What a getup environment runs from, as plain picklable data: every setting of the
+    task's ``GetupConfig`` (inherited, so each is declared once, there, with its default and source),
+    plus the values the task resolves from them (below; ``toolkit.policy.spec.spec_of``)."""
 
     curves: list = dataclasses.field(default_factory=list)  # FeatureCurve.to_dict() each
     fallen: list = dataclasses.field(default_factory=list)  # initial.fallen_states() entries
     reward: dict = dataclasses.field(default_factory=dict)  # {"terms": {name: params}}
-    natural_terms: list = default_of(_C, "natural_terms")
-    t_stand: float = default_of(_C, "t_stand")
-    p_standing: float = default_of(_C, "p_standing")
-    stand_pose: str = default_of(_C, "stand_pose")
-    p_fallen: float = default_of(_C, "p_fallen")
-    rsi: float = default_of(_C, "rsi")
-    rsi_from: float = default_of(_C, "rsi_from")
-    start_noise: float = default_of(_C, "start_noise")
-    curve_match_deg: float = default_of(_C, "curve_match_deg")
-    r_task_min: float = default_of(_C, "r_task_min")
-    sustain: float = default_of(_C, "sustain")
-    head_grace: float = default_of(_C, "head_grace")
-    success_height: float = default_of(_C, "success_height")
-    success_window: float = default_of(_C, "success_window")
-    heightmap_n: int = default_of(_C, "heightmap_n")
-    heightmap_spacing: float = default_of(_C, "heightmap_spacing")
     terrain: dict = dataclasses.field(default_factory=dict)  # resolved: TerrainSpec.to_dict(); {}: flat only
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})

@@ -40,7 +40,6 @@ from jt_tasks.jumping.features import CrossingTracker, suite_orientation
 from jt_tasks.jumping.scene import Suite, SuiteSpec
 from jt_tasks.jumping.config import JumpConfig as _C
 from toolkit.policy.env import CharacterEnv
-from toolkit.policy.spec import default_of
 from jt_tasks.takeoff.state import FOOT_LINKS, takeoff_state
 from toolkit.interfaces.simulator import ContactRule, Watch
 
@@ -48,24 +47,17 @@ HEAD = "neck"  #: the humanoid's link that carries the head (by name; ``setup`` 
 
 
 @dataclasses.dataclass
-class EnvSpec:
-    """Everything an environment needs, as plain picklable data. A field named as one of
-    ``JumpConfig``'s has its default from there (documented there); the rest are the task's
-    resolved values (``toolkit.policy.spec``)."""
+class EnvSpec(_C):
+    """What a jump environment runs from, as plain picklable data: every setting of the
+    task's ``JumpConfig`` (inherited, so each is declared once, there, with its default and source),
+    plus the values the task resolves from them (below; ``toolkit.policy.spec.spec_of``)."""
 
     kind: str = "highjump"  # highjump | obstacle
     features: dict = dataclasses.field(default_factory=dict)  # take-off features by name
     suite: SuiteSpec = dataclasses.field(default_factory=SuiteSpec)
-    clip: str = default_of(_C, "clip")
-    foot: str = default_of(_C, "foot")
-    omega_y: Optional[float] = default_of(_C, "omega_y")  # the task's: None for the obstacle jump (explored)
-    v_y: Optional[float] = default_of(_C, "v_y")  # None: the clip's own take-off speed
     takeoff_file: str = ""  # a run-up's takeoff_state.h5 to start from instead of the clip frame (takeoff_source)
     foot_clearance: float = 0.002  # m between the take-off foot and the ground at reset (ours)
-    time_limit: float = default_of(_C, "time_limit")
-    safe_margin: float = default_of(_C, "safe_margin")
     control_hz: float = 10.0  # initial control rate (the curriculum changes it)
-    check_every: int = default_of(_C, "check_every")
     sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
     reward_terms: dict = dataclasses.field(default_factory=dict)  # {term: params}

@@ -38,30 +38,18 @@ from jt_tasks.takeoff.state import FOOT_LINKS, heading_quat
 from jt_tasks.runup.reference import END_EFFECTORS, RunReference, facing_frame
 from jt_tasks.runup import reward as rw
 from toolkit.policy.env import CharacterEnv
-from toolkit.policy.spec import default_of
 from jt_tasks.runup.config import RunupConfig as _C
 from toolkit.interfaces.simulator import ContactRule, Watch
 from toolkit.motion import rotations as rot
 
 
 @dataclasses.dataclass
-class RunupSpec:
-    """Everything a run-up environment needs, as plain picklable data. A field named as one of
-    ``RunupConfig``'s has its default from there (documented there); ``target`` is the task's
-    resolved take-off features (``toolkit.policy.spec``)."""
+class RunupSpec(_C):
+    """What a run-up environment runs from, as plain picklable data: every setting of the
+    task's ``RunupConfig`` (inherited, so each is declared once, there, with its default and source),
+    plus the values the task resolves from them (below; ``toolkit.policy.spec.spec_of``)."""
 
-    kind: str = default_of(_C, "kind")
     target: dict = dataclasses.field(default_factory=dict)  # resolved: desired take-off features by name
-    omega_y: Optional[float] = default_of(_C, "omega_y")
-    clip: str = default_of(_C, "clip")
-    foot: str = default_of(_C, "foot")
-    n_strides: int = default_of(_C, "n_strides")
-    contact_tol: float = default_of(_C, "contact_tol")
-    foot_clearance: float = default_of(_C, "foot_clearance")
-    check_every: int = default_of(_C, "check_every")
-    w_imitation: float = default_of(_C, "w_imitation")
-    w_goal: float = default_of(_C, "w_goal")
-    goal_steps: Optional[float] = default_of(_C, "goal_steps")
     sim: dict = dataclasses.field(default_factory=dict)  # {"sim": ..., "spd": ..., "character": ...}
     action: dict = dataclasses.field(default_factory=lambda: {"name": "raw"})
 

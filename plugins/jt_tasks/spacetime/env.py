@@ -44,7 +44,6 @@ from typing import Any, Optional
 import numpy as np
 
 from toolkit.policy.env import CharacterEnv
-from toolkit.policy.spec import default_of
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig as _C
 from jt_tasks.spacetime import bounds as bd
@@ -56,33 +55,15 @@ _NO_LINKS = np.zeros((0, 3))  #: observe's link velocities with task.velocities=
 
 
 @dataclasses.dataclass
-class SpacetimeSpec:
-    """Everything a spacetime environment needs, as plain picklable data (``SpacetimeTask.env_spec``).
+class SpacetimeSpec(_C):
+    """What a spacetime environment runs from, as plain picklable data: every setting of the
+    task's ``SpacetimeConfig`` (inherited, so each is declared once, there, with its default and source),
+    plus the values the task resolves from them (below; ``toolkit.policy.spec.spec_of``)."""
 
-    A field named as one of ``SpacetimeConfig``'s has its default from there (its source and
-    meaning are documented there); the rest are the task's resolved values."""
-
-    clip: str = default_of(_C, "clip")
-    heading_axis: Optional[str] = default_of(_C, "heading_axis")  # x | z; None: per clip (clips.heading_axis)
-    loop: Optional[bool] = default_of(_C, "loop")
-    ground_clearance: float = default_of(_C, "ground_clearance")
-    cycle_turn: bool = default_of(_C, "cycle_turn")
-    straighten: bool = default_of(_C, "straighten")
-    root_orientation: str = default_of(_C, "root_orientation")
-    velocities: str = default_of(_C, "velocities")
-    ffc_lead: float = default_of(_C, "ffc_lead")
-    ffc_velocity: bool = default_of(_C, "ffc_velocity")
-    termination: str = default_of(_C, "termination")
     widths: list = dataclasses.field(default_factory=list)  # (n_channels,), inf = off; [] = 002 §5.1
     width_table: list = dataclasses.field(default_factory=list)  # (K, n_channels) over phase [0, 1]; [] = widths
-    time_limit: float = default_of(_C, "time_limit")
-    hold_s: float = default_of(_C, "hold_s")
-    init_phase: Optional[float] = default_of(_C, "init_phase")
     train_allowed: Optional[tuple] = None  # link indices allowed on the ground in the contact arm; None: per clip
     eval_allowed: Optional[tuple] = None  # ... in the evaluation; None: per clip (clips.allowed_links)
-    eval_time_limit: float = default_of(_C, "eval_time_limit")
-    style: list = default_of(_C, "style")  # [{"name": term, ...params}] (jt.rewards)
-    mix: Optional[float] = default_of(_C, "mix")
     sampling: dict = dataclasses.field(default_factory=dict)  # {"evolution": bool} (sampling.SamplingParams)
     sim: dict = dataclasses.field(default_factory=dict)
     action: dict = dataclasses.field(default_factory=lambda: {"name": "ffc_fbc"})

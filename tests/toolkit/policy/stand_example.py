@@ -3,7 +3,7 @@
 import dataclasses
 import numpy as np
 from toolkit.policy.env import CharacterEnv
-from toolkit.policy.spec import default_of, spec_of
+from toolkit.policy.spec import spec_of
 from toolkit.policy.task import PolicyConfig, PolicyTask
 from toolkit.interfaces import ContactRule, Watch
 
@@ -15,10 +15,9 @@ class StandConfig(PolicyConfig):     # filmstrip_frames, _width, _height come fr
     """s of standing asked for (ours)."""
 
 @dataclasses.dataclass
-class StandSpec:                      # picklable: rollout workers rebuild the env from it
-    sim: dict
-    action: dict
-    time_limit: float = default_of(StandConfig, "time_limit")  # one default: the Config's
+class StandSpec(StandConfig):         # picklable: rollout workers rebuild the env from it
+    sim: dict = dataclasses.field(default_factory=dict)     # every task.* setting inherited,
+    action: dict = dataclasses.field(default_factory=dict)  # plus what the task resolves
 
 class StandEnv(CharacterEnv):
     FEET = ("right_ankle", "left_ankle")  # the humanoid's ankle links, by name
@@ -48,4 +47,4 @@ class StandTask(PolicyTask):
 
     def env_spec(self, point):
         sim, action = self.character_groups()      # sim, spd, character, action groups as dicts
-        return spec_of(StandSpec, self.params, sim=sim, action=action)  # shared fields copied
+        return spec_of(StandSpec, self.params, sim=sim, action=action)  # the Config's fields copied
