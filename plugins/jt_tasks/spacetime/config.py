@@ -103,11 +103,11 @@ class SpacetimeConfig(PolicyConfig):
         code = self.evolution_reading == "code"
         term = self.termination if termination is None else termination
         return SamplingParams(
-            importance=(term == "bounds") if self.importance_sampling is None else bool(self.importance_sampling),
-            n_segments=int(self.n_segments), uniform=float(self.is_uniform), average=float(self.is_average),
-            is_reading=str(self.is_reading), evolution=bool(self.evolution), buffer_size=int(self.evolution_size),
-            share=(0.8 if code else 1.0) if self.evolution_share is None else float(self.evolution_share),
-            warmup=(400 if code else 0) if self.evolution_warmup is None else int(self.evolution_warmup),
+            importance_sampling=(term == "bounds") if self.importance_sampling is None else bool(self.importance_sampling),
+            n_segments=int(self.n_segments), is_uniform=float(self.is_uniform), is_average=float(self.is_average),
+            is_reading=str(self.is_reading), evolution=bool(self.evolution), evolution_size=int(self.evolution_size),
+            evolution_share=(0.8 if code else 1.0) if self.evolution_share is None else float(self.evolution_share),
+            evolution_warmup=(400 if code else 0) if self.evolution_warmup is None else int(self.evolution_warmup),
             evolution_reading=str(self.evolution_reading), decay=0.95 if code else 1.0)
 
     def check(self) -> None:

@@ -81,19 +81,20 @@ def boltzmann_draw(w: np.ndarray, m: int, rng: np.random.Generator, reading: str
 
 @dataclasses.dataclass
 class SamplingParams:
-    """The knobs of ``StartSampler``, all required: their defaults and sources live once, in
-    ``SpacetimeConfig`` (``task.*``), which builds this with ``sampling_params()``; ``defaults()``
-    gives that (for tests and scripts)."""
+    """The knobs of ``StartSampler``, all required and named as the ``task.*`` settings they come
+    from: their defaults and sources live once, in ``SpacetimeConfig``, which builds this with
+    ``sampling_params()`` (filling in a reading's defaults where a setting is null); ``decay`` is
+    the only derived one (0.95 with the authors' code's reading of eq 12, else 1)."""
 
-    importance: bool
+    importance_sampling: bool
     n_segments: int
-    uniform: float
-    average: float
+    is_uniform: float
+    is_average: float
     is_reading: str
     evolution: bool
-    buffer_size: int
-    share: float
-    warmup: int
+    evolution_size: int
+    evolution_share: float
+    evolution_warmup: int
     evolution_reading: str
     decay: float
 
@@ -112,7 +113,7 @@ class StartSampler:
 
     def __init__(self, params: SamplingParams, extra: dict, seed: int, state_dim: Optional[int] = None) -> None:
         self.p, self.extra, self.seed = params, extra, int(seed)
-        n, m = params.n_segments, params.buffer_size
+        n, m = params.n_segments, params.evolution_size
         d = 0 if state_dim is None else int(state_dim)
         self.extra.setdefault(self.KEY, {
             "w": np.zeros(n), "seen": np.zeros(n), "history": np.zeros((0, 1 + 3 * n)),
@@ -125,9 +126,9 @@ class StartSampler:
     def probabilities(self) -> np.ndarray:
         """Eq 11 start-segment probabilities ``(n,)`` now (uniform with importance sampling off)."""
         n = self.p.n_segments
-        if not self.p.importance:
+        if not self.p.importance_sampling:
             return np.full(n, 1.0 / n)
-        return is_probabilities(self.state["w"], self.p.uniform, self.p.is_reading)
+        return is_probabilities(self.state["w"], self.p.is_uniform, self.p.is_reading)
 
     def record_starts(self, starts: list[dict]) -> None:
         """Running-average update of ``w`` from the episode starts' ``start_phase`` and ``target``."""
@@ -139,12 +140,12 @@ class StartSampler:
         for k in range(n):
             mask = seg == k
             if mask.any():
-                st["w"][k] = self.p.average * st["w"][k] + (1.0 - self.p.average) * float(tgt[mask].mean())
+                st["w"][k] = self.p.is_average * st["w"][k] + (1.0 - self.p.is_average) * float(tgt[mask].mean())
                 st["seen"][k] += float(mask.sum())
 
     def refresh(self, visits: list[dict], iteration: int) -> None:
         """Eq 12: redraw every segment's buffer from its visited states and its old buffer."""
-        st, n, m = self.state, self.p.n_segments, self.p.buffer_size
+        st, n, m = self.state, self.p.n_segments, self.p.evolution_size
         rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([self.seed, 12, int(iteration)])))
         d = int(st["states"].shape[2])
         if visits:
@@ -170,7 +171,7 @@ class StartSampler:
 
     def update(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
         """PPO's ``on_iteration``: update eq 11 and eq 12, log the distribution, return the payload."""
-        if self.p.importance:
+        if self.p.importance_sampling:
             self.record_starts(list(getattr(stats, "starts", []) or []))
         if self.p.evolution:
             self.refresh(list(getattr(stats, "visits", []) or []), iteration)
@@ -184,9 +185,9 @@ class StartSampler:
         """What every env gets: ``probs`` ``(n,)`` and, once the evolution is on, ``states`` ``(n, m, d)``,
         ``count`` ``(n,)`` and ``share`` (the fraction of starts drawn from a buffer)."""
         out: dict[str, Any] = {"probs": self.probabilities()}
-        if self.p.evolution and iteration >= self.p.warmup:
+        if self.p.evolution and iteration >= self.p.evolution_warmup:
             st = self.state
-            out.update(states=st["states"].copy(), count=st["count"].copy(), share=float(self.p.share))
+            out.update(states=st["states"].copy(), count=st["count"].copy(), share=float(self.p.evolution_share))
         return out
 
     def history(self) -> Optional[dict[str, np.ndarray]]:

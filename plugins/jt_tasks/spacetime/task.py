@@ -97,7 +97,7 @@ class SpacetimeTask(PolicyTask):
 
         params = self.params.sampling_params()
         extra: dict[str, Any] = {}
-        sampler = StartSampler(params, extra, ctx.seed) if (params.importance or params.evolution) else None
+        sampler = StartSampler(params, extra, ctx.seed) if (params.importance_sampling or params.evolution) else None
         total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
         hook = SpacetimeTraining(sampler, functools.partial(self.env_class, spec, seed=ctx.seed),
                                  self.final_options(None), int(self.params.eval_every), extra, ctx.progress, total,

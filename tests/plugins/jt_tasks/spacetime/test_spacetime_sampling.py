@@ -63,7 +63,7 @@ def test_importance_weights_favour_the_segment_with_low_returns():
 
 
 def test_importance_off_is_uniform():
-    s = sm.StartSampler(_defaults(importance=False), {}, seed=0)
+    s = sm.StartSampler(_defaults(importance_sampling=False), {}, seed=0)
     p = s.update(1, 10, type("S", (), {"starts": starts_with_low_segment(3)})())["start_sampling"]["probs"]
     assert np.allclose(p, 0.1)
 
@@ -76,8 +76,8 @@ def visits(n: int, seed: int, d: int = 5) -> list[dict]:
 
 @pytest.mark.parametrize("reading", ["paper", "code"])
 def test_evolution_keeps_m_states_per_segment_and_leans_as_its_reading(reading):
-    params = _defaults(evolution=True, buffer_size=20, evolution_reading=reading,
-                               decay=0.95 if reading == "code" else 1.0)
+    params = _defaults(evolution=True, evolution_size=20, evolution_reading=reading,
+                      decay=0.95 if reading == "code" else 1.0)
     s = sm.StartSampler(params, {}, seed=0)
     v = visits(2000, 1)
     s.refresh(v, 1)
@@ -94,7 +94,7 @@ def test_evolution_keeps_m_states_per_segment_and_leans_as_its_reading(reading):
 
 def test_evolution_is_seeded():
     def run(seed):
-        s = sm.StartSampler(_defaults(evolution=True, buffer_size=8), {}, seed=seed)
+        s = sm.StartSampler(_defaults(evolution=True, evolution_size=8), {}, seed=seed)
         s.refresh(visits(500, 3), 1)
         return s.state["states"].copy()
 
@@ -143,7 +143,7 @@ def test_ppo_reports_visits_with_targets_and_the_starts_follow_the_payload():
     from spacetime_helpers import make_spec
 
     spec = make_spec(sampling={"evolution": True}, time_limit=0.5)
-    sampler = sm.StartSampler(_defaults(evolution=True, buffer_size=4, n_segments=4), {}, seed=0)
+    sampler = sm.StartSampler(_defaults(evolution=True, evolution_size=4, n_segments=4), {}, seed=0)
     seen: list = []
 
     def on_iteration(it, samples, stats):
@@ -209,10 +209,10 @@ def test_code_reading_fills_in_the_authors_defaults():
 
     t, _ = task("task.evolution=true", "task.evolution_reading=code")
     p = t.params.sampling_params()
-    assert (p.share, p.warmup, p.decay, p.importance) == (0.8, 400, 0.95, True)
+    assert (p.evolution_share, p.evolution_warmup, p.decay, p.importance_sampling) == (0.8, 400, 0.95, True)
     t, _ = task("task.termination=contact")
     p = t.params.sampling_params()
-    assert (p.share, p.warmup, p.decay, p.importance, p.evolution) == (1.0, 0, 1.0, False, False)
+    assert (p.evolution_share, p.evolution_warmup, p.decay, p.importance_sampling, p.evolution) == (1.0, 0, 1.0, False, False)
 
 
 def test_evaluation_during_training_ends_on_the_final_policys_survival(tmp_path):
