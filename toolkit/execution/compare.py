@@ -32,14 +32,45 @@ class CompareResult:
     rows: list[dict[str, Any]]
 
 
+def split_values(values: str, whole: str = "") -> list[str]:
+    """The values of one ``--vary``, split at the commas outside brackets and quotes:
+    ``"[30,60],[600]"`` → ``["[30,60]", "[600]"]``, ``"'a,b',c"`` → ``["'a,b'", "c"]``.
+
+    Raises:
+        JtError: an unclosed bracket or quote (one line naming the ``--vary``).
+    """
+    items, depth, quote, start = [], 0, "", 0
+    pairs = {"[": "]", "{": "}", "(": ")"}
+    closing: list[str] = []
+    for i, ch in enumerate(values):
+        if quote:
+            quote = "" if ch == quote else quote
+        elif ch in "'\"":
+            quote = ch
+        elif ch in pairs:
+            closing.append(pairs[ch])
+        elif ch in ")]}":
+            if not closing or closing.pop() != ch:
+                raise JtError(f"bad --vary '{whole or values}': unmatched '{ch}'")
+        elif ch == "," and not closing:
+            items.append(values[start:i])
+            start = i + 1
+        depth = len(closing)
+    if quote or depth:
+        raise JtError(f"bad --vary '{whole or values}': unclosed {quote or closing[-1]!r}")
+    items.append(values[start:])
+    return items
+
+
 def parse_vary(vary: Sequence[str]) -> list[tuple[str, list[str]]]:
-    """``["spd=df,maba"]`` → ``[("spd", ["df", "maba"])]``."""
+    """``["spd=df,maba"]`` → ``[("spd", ["df", "maba"])]``; list and dict values keep their inner
+    commas (``task.rates_hz=[30,60],[600]``)."""
     out = []
     for v in vary:
         if "=" not in v or not v.split("=", 1)[1]:
             raise JtError(f"bad --vary '{v}': expected KEY=a,b[,c]")
         key, values = v.split("=", 1)
-        items = [s.strip() for s in values.split(",") if s.strip()]
+        items = [s.strip() for s in split_values(values, v) if s.strip()]
         if not items:
             raise JtError(f"bad --vary '{v}': no values (expected KEY=a,b[,c])")
         if len(set(items)) != len(items):
@@ -123,6 +154,13 @@ def compare(overrides: Sequence[str], vary: Sequence[str], seeds: int) -> Compar
             ov = [*plain, *(f"{k}={v}" for k, v in chosen.items()), f"seed={first + s}"]
             cfg = compose(ov)  # check every cell before running any
             cells.append((values, ov, cfg))
+    from toolkit.execution.runner import preflight
+
+    for values, ov, cfg in cells:  # and what the cell's plugins check, before a compare row opens
+        try:
+            preflight(cfg)
+        except JtError as e:
+            raise JtError(f"cell {' '.join(ov)}: {e}") from None
     store = open_store(store_root(str(base.store)))
     task_cls = plugins.load("task", str(base.task.name))
     label = ", ".join(f"{k}={','.join(v)}" for k, v in grid)

@@ -73,6 +73,26 @@ def _train_prior(store: Any, overrides: Sequence[str], tag: str) -> str:
     return run(compose([*overrides, f"store={store.root}"])).run_id
 
 
+def preflight(cfg: Any) -> tuple[Any, Any, Any, Any, Any]:
+    """Every check of a composed config that needs its plugins, before anything is trained or a run
+    row opens: the task's own (``problem()``) and the searcher's with that problem (a task without
+    objectives for rmoo, a constraint it cannot keep). ``jt compare`` runs it on every cell first.
+
+    Returns:
+        ``(task_cls, search_cls, exec_cls, task, problem)``.
+
+    Raises:
+        JtError: one line, what is wrong with this config.
+    """
+    task_cls = plugins.load("task", str(cfg.task.name))
+    search_cls = plugins.load("search", str(cfg.search.name))
+    exec_cls = plugins.load("executor", str(cfg.executor.name))
+    task = task_cls(cfg)
+    problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
+    search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
+    return task_cls, search_cls, exec_cls, task, problem
+
+
 def run(cfg: Any, command: Optional[str] = None) -> RunResult:
     """Run a composed, validated config (see ``toolkit.config.compose``) to completion.
 
@@ -85,12 +105,7 @@ def run(cfg: Any, command: Optional[str] = None) -> RunResult:
 
     from toolkit.priors import auto as auto_prior
 
-    task_cls = plugins.load("task", str(cfg.task.name))
-    search_cls = plugins.load("search", str(cfg.search.name))
-    exec_cls = plugins.load("executor", str(cfg.executor.name))
-    task = task_cls(cfg)
-    problem = task.problem()  # the task's own checks, before a prior is trained or a run opens
-    search_cls(problem, cfg.search, int(cfg.seed))  # and the searcher's (a task without objectives for rmoo)
+    task_cls, search_cls, exec_cls, task, problem = preflight(cfg)
     if cfg.get("cost"):  # what the wait costs, before any work (a prior trained first included)
         _log(f"jt: cost: {cfg.cost}")
     auto = auto_prior.wants_auto(cfg)

@@ -154,3 +154,30 @@ def test_runs_are_told_apart_by_the_params_they_set():
     assert [variant_label(p, diff) for p in (cvae, nofilter, raw)] == [
         "action=cvae, action.beta=0.2", "action=cvae, action.beta=1.0", "action=raw"]
     assert differing_params([cvae, {**cvae, "seed": "5"}]) == []
+
+
+def test_a_cell_its_plugins_refuse_is_one_line_before_any_cell_runs(tmp_path):
+    """``--vary search=random,bds`` on a task BDS cannot search: the random cell used to run all
+    60 evaluations and then the compare run was left FAILED; now nothing is run or written."""
+    import pytest
+
+    from toolkit.errors import JtError
+
+    store = tmp_path / "s"
+    with pytest.raises(JtError) as e:
+        compare(["task=zdt1", "experiment=smoke", f"store={store}"], ["search=random,bds"], 1)
+    assert "search=bds" in str(e.value) and "n_features" in str(e.value) and "\n" not in str(e.value)
+    assert not store.exists()
+
+
+def test_vary_keeps_list_dict_and_quoted_values_whole():
+    import pytest
+
+    from toolkit.errors import JtError
+
+    assert parse_vary(["task.rates_hz=[30,60],[600]"]) == [("task.rates_hz", ["[30,60]", "[600]"])]
+    assert parse_vary(["x={a: 1, b: 2},{a: 3}"]) == [("x", ["{a: 1, b: 2}", "{a: 3}"])]
+    assert parse_vary(["x='a,b',c"]) == [("x", ["'a,b'", "c"])]
+    for bad in ("x=[1,2", "x=1],2", "x='a,b"):
+        with pytest.raises(JtError, match="bad --vary"):
+            parse_vary([bad])
