@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import platform
 from pathlib import Path
 from typing import List, Optional
@@ -19,6 +20,37 @@ def _split(value: str, valid: "tuple[str, ...] | list[str]", what: str) -> list[
     if bad or not items:
         raise JtError(f"unknown {what} '{','.join(bad) or value}'; choose from: {', '.join(valid)}")
     return items
+
+
+def writable(path: Optional[Path], option: str) -> None:
+    """One ``JtError`` line, before any work, when ``path`` cannot be written (its folder is
+    created as writing would create it; a file made for the check is removed again)."""
+    if path is None:
+        return
+    existed = path.exists()
+    try:
+        if path.is_dir():
+            raise IsADirectoryError(21, "is a folder")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "a"):
+            pass
+    except OSError as e:
+        raise JtError(f"{option} {path}: cannot write there ({e.strerror or e}); give another path") from None
+    if not existed:
+        path.unlink()
+
+
+def check_rates(task: str, overrides: List[str], rates: List[float]) -> None:
+    """Each control rate divides the task's simulation rate into whole substeps, as ``jt run``
+    requires; one ``JtError`` line naming the rates that would work."""
+    from toolkit.config import compose, group_of
+
+    sim_hz = float(group_of(group_of(compose([f"task={task}", *overrides]), "sim"), "sim_hz"))
+    bad = [r for r in rates if abs(sim_hz / r - round(sim_hz / r)) > 1e-6 or round(sim_hz / r) < 1]
+    if bad:
+        ok = [sim_hz / n for n in range(1, 61) if (sim_hz / n).is_integer()][:8]
+        raise JtError(f"--rates {','.join(f'{r:g}' for r in bad)}: task={task} simulates at {sim_hz:g} Hz and a control "
+                      f"rate must divide it into whole substeps (e.g. {', '.join(f'{r:g}' for r in ok)})")
 
 
 def machine_info() -> dict:
@@ -56,6 +88,10 @@ def bench_spd(
     from toolkit.quiet import preload_quietly
 
     preload_quietly()  # no native banner among the rows
+    if samples < 1:
+        raise JtError(f"--samples must be >= 1, got {samples}")
+    writable(json_out, "--json")
+    writable(plot, "--plot")
     sim = plugins.load("sim", sim_name or plugins.sole("sim", "--sim"))  # the benchmark and its characters
     bench, loader = getattr(sim, "spd_bench", lambda: None)(), sim.load_character
     if bench is None:
@@ -157,6 +193,7 @@ def bench_rollout(
     worker, and training's samples/s with the PPO updates (as jt run trains)."""
     from toolkit import plugins
     from toolkit.config import group_options
+    from toolkit.quiet import preload_quietly
     from toolkit.rl.rollout_bench import check_policy_task, format_table, run_bench, task_overrides
 
     if spd != "task" and len(_split(spd, plugins.names("spd"), "backend")) != 1:
@@ -176,8 +213,10 @@ def bench_rollout(
     except ValueError:
         raise JtError(f"--rates, --workers and --train-workers take comma lists of numbers, got {rates!r}, "
                       f"{workers!r}, {train_workers!r}") from None
-    if not rate_list or any(r <= 0 for r in rate_list):
+    if not rate_list or not all(math.isfinite(r) and r > 0 for r in rate_list):
         raise JtError(f"--rates takes positive control rates (Hz), got {rates!r}")
+    if collect_steps < 1:
+        raise JtError(f"--collect-steps must be >= 1 (steps per env of the collection measurement), got {collect_steps}")
     if not worker_list or any(w < 1 for w in worker_list):
         raise JtError(f"--workers takes worker counts >= 1, got {workers!r}")
     if repeats < 1 or steps < 1:
@@ -194,8 +233,12 @@ def bench_rollout(
     dashed = [o for o in extra if o.startswith("-")]
     if dashed:  # a mistyped option would otherwise read as a Hydra override
         raise JtError(f"no such option: {dashed[0]} (see: jt bench rollout --help)")
+    writable(json_out, "--json")  # before the benchmark, not after it
+    preload_quietly()  # no native banner among the figures
     plans = [(t, loop, *task_overrides(t, action, spd, [f"sim.loop={loop}", *extra]))  # every config composes first
              for t in names for loop in loop_list]
+    for t, _, over, _ in plans:  # a rate jt run would refuse (600 / 7 substeps) is refused here too
+        check_rates(t, over, rate_list)
     out = {"machine": machine_info(), "results": []}
     for t, loop, over, header in plans:
         typer.echo(f"{t}, sim.loop={loop}: measuring ...")

@@ -26,3 +26,23 @@ def test_bad_lists_are_one_line_naming_the_installed_choices():
     assert p.stderr.strip().startswith("jt: unknown model 'robot'; choose from: ") and "snake36" in p.stderr
     p = run_jt("bench", "spd", "--sim", "nosuch")
     assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and "bullet" in p.stderr
+
+
+def test_bench_rollout_refuses_what_jt_run_would_before_measuring(tmp_path):
+    """A NaN rate, a rate that does not divide 600 Hz into whole substeps, no collection steps and
+    an unwritable --json are one line each, before any measurement (the --json one used to come
+    after the whole benchmark)."""
+    cases = {("--rates", "nan"): "--rates takes positive control rates",
+             ("--rates", "85.71"): "divide it into whole substeps",
+             ("--collect-steps", "0"): "--collect-steps must be >= 1",
+             ("--json", str(tmp_path / "a_file" / "x.json")): "cannot write there"}
+    (tmp_path / "a_file").write_text("not a folder")
+    for args, says in cases.items():
+        p = run_jt("bench", "rollout", *args)
+        assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, (args, p.stderr)
+        assert says in p.stderr and "measuring" not in p.stdout, (args, p.stdout)
+
+
+def test_bench_spd_checks_its_output_paths_first(tmp_path):
+    p = run_jt("bench", "spd", "--models", "humanoid", "--json", str(tmp_path))
+    assert p.returncode == 2 and "--json" in p.stderr and "is a folder" in p.stderr and "model" not in p.stdout
