@@ -40,6 +40,9 @@ def run_cmd(
     from toolkit.quiet import preload_quietly
 
     preload_quietly()  # no native banner on the terminal, from composing on (workers do the same)
+    from toolkit.execution.progress import check_env
+
+    check_env()
 
     ov = list(overrides or [])
     resume = [o.split("=", 1)[1] for o in ov if o.startswith("resume=")]
@@ -114,6 +117,9 @@ def compare_cmd(
     from toolkit.quiet import preload_quietly
 
     preload_quietly()
+    from toolkit.execution.progress import check_env
+
+    check_env()
 
     extra_runs = [o for o in (overrides or []) if "=" not in o] if runs else []
     if runs:
@@ -182,6 +188,26 @@ def plugins_cmd(kind: Optional[str] = typer.Argument(None, help="Only this kind 
     widths = [max(len(r[i]) for r in rows) for i in range(3)]
     for r in rows:
         typer.echo(f"{r[0]:<{widths[0]}}  {r[1]:<{widths[1]}}  {r[2]:<{widths[2]}}  {r[3]}".rstrip())
+
+
+@app.command("study", context_settings={"allow_extra_args": True, "ignore_unknown_options": True,
+                                         "help_option_names": []})
+def study_cmd(ctx: typer.Context, task: Optional[str] = typer.Argument(None, help="A task with analysis tools."),
+              tool: Optional[str] = typer.Argument(None, help="One of its tools (TOOL --help: its arguments).")) -> None:
+    """Analysis tools the tasks ship (figures and tables from runs): jt study [TASK [TOOL ARGS...]]."""
+    from toolkit import study
+
+    if task in ("-h", "--help") or (task is None and tool is None):
+        typer.echo("jt study TASK TOOL [ARGS...]: the analysis tools the tasks ship (TOOL --help: its arguments)")
+        for line in study.listing():
+            typer.echo(f"  {line}")
+        return
+    if tool is None or tool in ("-h", "--help"):
+        for line in study.listing(task):
+            typer.echo(line)
+        return
+    main_fn = study.find(task, tool)
+    main_fn(list(ctx.args))
 
 
 def _store_arg(overrides: Optional[List[str]]) -> Optional[str]:

@@ -40,6 +40,10 @@ CASES = [
     (["task=spd_tracking", "task.duration=-1"], r"task.duration=-1.0: must be >= 0 s"),
     (["task=getup", "action=raw", "task.terrain=null", "task.eval_regions=[flat,hard]"],
      r"only flat without a terrain \(task.terrain=null\)"),
+    # issue 55: values that would silently do nothing
+    (["task=spacetime", "task.straighten=true", "task.loop=false"], r"task.straighten=True: .*does nothing on a clip"),
+    (["task=getup", "action=raw", "task.rsi=0.5", "task.p_standing=0.5", "task.p_fallen=0.5"],
+     r"task.rsi=0.5: shapes the episodes that start from a clip"),
 ]
 
 
@@ -112,4 +116,17 @@ def test_files_named_in_a_config_are_read_before_anything_runs(tmp_path):
         with pytest.raises(JtError, match=message) as e:
             compose([*overrides, f"store={store}"])
         assert "\n" not in str(e.value)
+    assert not store.exists()
+
+
+def test_an_unknown_progress_mode_is_one_line(tmp_path):
+    """``JT_PROGRESS=bars`` was ignored (a bar on a terminal, lines elsewhere, whatever it said)."""
+    import os
+    import subprocess
+
+    store = tmp_path / "store"
+    p = subprocess.run(["jt", "run", "task=zdt1", "experiment=smoke", f"store={store}"], capture_output=True,
+                       text=True, env={**os.environ, "JT_PROGRESS": "bars"}, timeout=120)
+    assert p.returncode == 2 and p.stderr.strip() == \
+        "jt: JT_PROGRESS='bars': choose bar or lines (unset: a bar on a terminal, lines elsewhere)"
     assert not store.exists()

@@ -27,6 +27,19 @@ LINE_EVERY_S = 10.0  #: seconds between progress lines off a terminal
 QUIET_S = 2.0  #: an evaluation shows progress only once it has run this long
 
 
+MODES = ("bar", "lines")  #: what JT_PROGRESS may force
+
+
+def check_env() -> None:
+    """One ``JtError`` line for a ``JT_PROGRESS`` that names no mode (it would be ignored)."""
+    forced = os.environ.get("JT_PROGRESS", "").strip().lower()
+    if forced and forced not in MODES:
+        from toolkit.errors import JtError
+
+        raise JtError(f"JT_PROGRESS={os.environ['JT_PROGRESS']!r}: choose bar or lines "
+                      "(unset: a bar on a terminal, lines elsewhere)")
+
+
 def mode() -> str:
     """``bar`` on an interactive terminal, else ``lines`` (``JT_PROGRESS`` overrides)."""
     forced = os.environ.get("JT_PROGRESS", "").strip().lower()

@@ -171,6 +171,9 @@ class GetupConfig(PolicyConfig):
             require(finite(v) and 0.0 <= v <= 1.0, f"task.{key}", v, "must be in [0, 1]")
         require(self.p_standing + self.p_fallen <= 1.0, "task.p_standing+p_fallen",
                 self.p_standing + self.p_fallen, "must be <= 1")
+        require(not self.rsi or self.p_standing + self.p_fallen < 1.0, "task.rsi", self.rsi,
+                "shapes the episodes that start from a clip, and with task.p_standing + task.p_fallen = 1 none "
+                "does; set task.rsi=0 or lower one of them")
         for key in ("t_stand", "sustain", "settle_max", "time_scale", "heightmap_spacing", "success_height"):
             v = getattr(self, key)
             require(finite(v) and v > 0, f"task.{key}", v, "must be a finite number > 0")

@@ -118,7 +118,11 @@ class SpacetimeConfig(PolicyConfig):
         from jt_tasks.spacetime import bounds as bd
         from jt_tasks.spacetime.reference import load_humanoid_clip
 
-        load_humanoid_clip(self.clip)
+        clip = load_humanoid_clip(self.clip)
+        loops = bool(clip.loop) if self.loop is None else bool(self.loop)
+        require(not self.straighten or loops, "task.straighten", self.straighten,
+                "removes a looping clip's yaw drift and does nothing on a clip that does not loop "
+                "(task.loop=false); drop one of them")
         require(self.heading_axis in (None, "x", "z"), "task.heading_axis", self.heading_axis, "x or z (null: per clip)")
         require(self.root_orientation in ("world", "heading"), "task.root_orientation", self.root_orientation,
                 "world or heading")
