@@ -95,6 +95,8 @@ class Task(Plugin, abc.ABC):
         curriculum_attrs: the environment attributes a curriculum may drive (None: not
             declared). With it, composition refuses a curriculum that drives others
             (``Curriculum.drives``): it would set attributes nothing reads.
+        studies: the analysis tools it ships, ``{tool: "module:main"}``, run as ``jt study
+            <task> <tool> ...`` (``toolkit.study``); empty by default.
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
@@ -107,6 +109,7 @@ class Task(Plugin, abc.ABC):
     record_keys: ClassVar[Optional[frozenset[str]]] = None
     action_inputs: ClassVar[Optional[frozenset[str]]] = None
     curriculum_attrs: ClassVar[Optional[frozenset[str]]] = None
+    studies: ClassVar[dict[str, str]] = {}
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg
