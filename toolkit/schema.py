@@ -292,9 +292,10 @@ def run_checks(cfg: Any) -> None:
 
 
 def check_declared_needs(cfg: Any, task_cls: type) -> None:
-    """What the chosen reward terms, action space and curriculum need against what the task says
-    it provides (``Task.record_keys``, ``action_inputs``, ``curriculum_attrs``; an undeclared
-    side is not checked): one ``JtError`` line naming both sides, before a run opens."""
+    """What the chosen reward terms, action space, SPD backend and curriculum need against what the
+    task says it provides or needs (``Task.record_keys``, ``action_inputs``, ``needs_spd_torques``,
+    ``curriculum_attrs``; an undeclared side is not checked): one ``JtError`` line naming both
+    sides, before a run opens."""
     name = str(cfg.task["name"])
     provided = getattr(task_cls, "record_keys", None)
     reward = cfg.get("reward")
@@ -311,6 +312,12 @@ def check_declared_needs(cfg: Any, task_cls: type) -> None:
         if needs - set(inputs):
             raise JtError(f"action={action['name']} needs {', '.join(sorted(needs - set(inputs)))} from the task, which "
                           f"task={name} does not give (it gives: {', '.join(sorted(inputs)) or 'nothing'})")
+    spd = cfg.get("spd")
+    if getattr(task_cls, "needs_spd_torques", False) and spd is not None and "name" in spd \
+            and getattr(plugins.load("spd", str(spd["name"])), "steps_itself", False):
+        able = [n for n in plugins.names("spd") if not getattr(plugins.load("spd", n), "steps_itself", False)]
+        raise JtError(f"spd={spd['name']} computes its torques inside the simulator's step, and task={name} needs "
+                      f"the torques; use one of: {', '.join(able)}")
     attrs = getattr(task_cls, "curriculum_attrs", None)
     cur = cfg.get("curriculum")
     if attrs is not None and cur is not None and "name" in cur:

@@ -145,7 +145,17 @@ class BulletSimulator(SceneQueries, Simulator):
     def check_run(cls, cfg: Any) -> None:
         """Per-joint overrides (``character.joint_kp`` / ``joint_kd`` / ``joint_torque_limit``) name
         joints the character has: checked at composition by loading it once in a private DIRECT
-        client (~0.2 s, only when such a table is given), one line listing the joints otherwise."""
+        client (~0.2 s, only when such a table is given), one line listing the joints otherwise.
+        And a root servo (``sim.root_servo.kp`` > 0) needs a backend whose torques it can add to."""
+        from toolkit import plugins
+        from toolkit.errors import JtError
+
+        spd_name = str(_get(_get(cfg, "spd"), "name") or "maba")
+        servo = _get(_get(cfg, "sim"), "root_servo")
+        if float(_get(servo, "kp") or 0.0) != 0.0 and getattr(plugins.load("spd", spd_name), "steps_itself", False):
+            able = [n for n in plugins.names("spd") if not getattr(plugins.load("spd", n), "steps_itself", False)]
+            raise JtError(f"spd={spd_name} cannot drive a root servo (it computes its torques inside the step and "
+                          f"leaves the root unactuated); use spd={'/'.join(able)} or sim.root_servo.kp=0")
         cc = CharacterConfig.from_node(_get(cfg, "character"))
         if not (cc.joint_kp or cc.joint_kd or cc.joint_torque_limit):
             return

@@ -40,6 +40,14 @@ CASES = [
     (["task=spd_tracking", "task.duration=-1"], r"task.duration=-1.0: must be >= 0 s"),
     (["task=getup", "action=raw", "task.terrain=null", "task.eval_regions=[flat,hard]"],
      r"only flat without a terrain \(task.terrain=null\)"),
+    # issue 55: combinations refused before the run row (they failed after it)
+    (["task=spd_tracking", "spd=servo"], r"spd=servo cannot drive the tracking's root servo"),
+    (["task=standing_jump", "spd=servo"], r"spd=servo computes its torques inside the simulator's step, and "
+                                          r"task=standing_jump needs the torques; use one of: df, maba, pcg, sf"),
+    (["task=spd_tracking", "character=snake36", "task.motion=walk"], r"the snakes track the generated 'slither'"),
+    (["task=spd_tracking", "task.motion=slither"], r"task.motion=slither is for the snakes"),
+    (["task=spd_tracking", "character=atlas"], r"character=atlas: no motion to track"),
+    (["task=highjump", "spd=servo", "sim.root_servo.kp=100"], r"spd=servo cannot drive a root servo"),
     # issue 55: values that would silently do nothing
     (["task=spacetime", "task.straighten=true", "task.loop=false"], r"task.straighten=True: .*does nothing on a clip"),
     (["task=getup", "action=raw", "task.rsi=0.5", "task.p_standing=0.5", "task.p_fallen=0.5"],

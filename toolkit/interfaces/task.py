@@ -95,6 +95,9 @@ class Task(Plugin, abc.ABC):
         curriculum_attrs: the environment attributes a curriculum may drive (None: not
             declared). With it, composition refuses a curriculum that drives others
             (``Curriculum.drives``): it would set attributes nothing reads.
+        needs_spd_torques: True when the task reads or changes the SPD torques each substep (its
+            own force terms, limits, timing): composition then refuses a backend that computes
+            its torques inside the simulator's step (``SPDBackend.steps_itself``). False by default.
         studies: the analysis tools it ships, ``{tool: "module:main"}``, run as ``jt study
             <task> <tool> ...`` (``toolkit.study``); empty by default.
 
@@ -109,6 +112,7 @@ class Task(Plugin, abc.ABC):
     record_keys: ClassVar[Optional[frozenset[str]]] = None
     action_inputs: ClassVar[Optional[frozenset[str]]] = None
     curriculum_attrs: ClassVar[Optional[frozenset[str]]] = None
+    needs_spd_torques: ClassVar[bool] = False
     studies: ClassVar[dict[str, str]] = {}
 
     def __init__(self, cfg: Any) -> None:

@@ -113,12 +113,28 @@ class SPDTrackingTask(Task):
 
         from jt_tasks.spd_tracking.motions import default_motion, motion_path
 
+        from toolkit import plugins
+
+        task = group_of(cfg, "task")
+        spd = str(group_of(group_of(cfg, "spd"), "name") or "")
+        if float(group_of(task, "root_kp") or 0.0) != 0.0 and spd and \
+                getattr(plugins.load("spd", spd), "steps_itself", False):
+            able = [n for n in plugins.names("spd") if not getattr(plugins.load("spd", n), "steps_itself", False)]
+            raise JtError(f"spd={spd} cannot drive the tracking's root servo (task.root_kp: it computes its torques "
+                          f"inside the step and leaves the root unactuated); use spd={'/'.join(able)} or task.root_kp=0")
         character = group_of(cfg, "character")
         name = str(group_of(character, "name") or "humanoid") if character is not None else "humanoid"
-        motion = str(group_of(group_of(cfg, "task"), "motion") or "auto")
+        motion = str(group_of(task, "motion") or "auto")
         motion = default_motion(name) if motion in ("auto", "") else motion
-        if not motion or motion == "slither" or name.startswith("snake"):
-            return  # make_reference says what the snakes and unknown characters can track
+        if name.startswith("snake") and motion != "slither":
+            raise JtError(f"task.motion={motion}: the snakes track the generated 'slither' (task.motion=auto)")
+        if motion == "slither" and not name.startswith("snake"):
+            raise JtError(f"task.motion=slither is for the snakes, not character={name}")
+        if not motion:
+            raise JtError(f"character={name}: no motion to track; tracking supports humanoid (mocap clips), "
+                          "laikago (walk) and the snakes (slither)")
+        if motion == "slither":
+            return
         try:
             path = motion_path(name, motion)
         except JtError as e:

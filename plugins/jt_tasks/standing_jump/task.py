@@ -35,6 +35,7 @@ class StandingJumpTask(Task):
     """Standing jump of a planar humanoid: jump height vs effort, natural and supernatural (004)."""
 
     ignores_groups: ClassVar[tuple[str, ...]] = ("action", "reward", "curriculum")
+    needs_spd_torques: ClassVar[bool] = True  #: it adds the virtual-force torques and applies the limits itself
 
     key_metrics: ClassVar[tuple[str, ...]] = ("hypervolume", "max_natural_height", "max_height", "n_front")
 
