@@ -61,9 +61,16 @@ def _parse(overrides: Sequence[str]) -> list[Any]:
     parser = OverridesParser.create()
     parsed = []
     for o in overrides:
+        key, eq, value = o.partition("=")
+        if eq and not key.strip().lstrip("+~"):
+            raise JtError(f"bad override '{o}': no key before '='; write KEY=VALUE (e.g. task.clip=walk)")
         try:
             parsed.extend(parser.parse_overrides([o]))
         except Exception as e:  # noqa: BLE001 - Hydra raises several types here
+            if eq and not value.isascii() and value[:1] not in "'\"":
+                raise JtError(f"bad override '{o}': a value with characters beyond ASCII letters, digits and "
+                              f"_-./ must be quoted: {key}='{value}' (on a shell command line: \"{key}='{value}'\")") \
+                    from None
             msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
             raise JtError(f"bad override '{o}': {msg}") from e
     return parsed

@@ -48,6 +48,10 @@ CASES = [
     (["task=spd_tracking", "task.motion=slither"], r"task.motion=slither is for the snakes"),
     (["task=spd_tracking", "character=atlas"], r"character=atlas: no motion to track"),
     (["task=highjump", "spd=servo", "sim.root_servo.kp=100"], r"spd=servo cannot drive a root servo"),
+    # issue 55: messages that name the key and the fix
+    (["task=highjump", "task.ranges={alpha: abc}"], r"task.ranges.alpha=abc: needs finite \[low, high\]"),
+    (["task=zdt1", "=x"], r"bad override '=x': no key before '='; write KEY=VALUE"),
+    (["task=zdt1", "run_name=höhe"], r"must be quoted: run_name='höhe' \(on a shell command line"),
     # issue 55: values that would silently do nothing
     (["task=spacetime", "task.straighten=true", "task.loop=false"], r"task.straighten=True: .*does nothing on a clip"),
     (["task=getup", "action=raw", "task.rsi=0.5", "task.p_standing=0.5", "task.p_fallen=0.5"],

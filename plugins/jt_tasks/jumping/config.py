@@ -84,9 +84,10 @@ class JumpConfig(PolicyConfig):
 
         require(self.stage in (1, 2), "task.stage", self.stage,
                 "1 (take-off exploration) or 2 (novel policy seeking)")
-        for key, (lo, hi) in {k: tuple(v) for k, v in (self.ranges or {}).items()}.items():
-            require(finite(lo) and finite(hi) and float(lo) < float(hi), f"task.ranges.{key}", [lo, hi],
-                    "needs finite [low, high] with low < high")
+        for key, box in (self.ranges or {}).items():
+            pair = [box] if isinstance(box, str) or not hasattr(box, "__len__") else list(box)
+            require(len(pair) == 2 and finite(pair[0]) and finite(pair[1]) and float(pair[0]) < float(pair[1]),
+                    f"task.ranges.{key}", box, "needs finite [low, high] with low < high")
         for key in ("distance", "time_limit", "distinct_threshold"):
             require(finite(getattr(self, key)) and getattr(self, key) > 0, f"task.{key}", getattr(self, key),
                     "must be a finite number > 0")
