@@ -60,6 +60,7 @@ def check_root(root: Path, must_exist: bool = False) -> None:
         root: the store folder.
         must_exist: refuse a folder without ``mlflow.db`` (reading commands never create a store).
     """
+    _check_length(root)
     if root.exists() and not root.is_dir():
         raise JtError(f"store={root} is a file, not a folder; give a folder (created if missing) "
                       "or an MLflow server URI http://host:port")
@@ -72,6 +73,34 @@ def check_root(root: Path, must_exist: bool = False) -> None:
         if head != SQLITE_MAGIC:
             raise JtError(f"store={root}: its mlflow.db is not an SQLite database (corrupt, or another "
                           "file); move it away to start a new store there, or give another store=")
+
+
+INNER_PATH_BYTES = 300  #: room for what jt keeps under a store (runs/<experiment>/<run id>/artifacts/...)
+
+
+def _check_length(root: Path) -> None:
+    """One ``JtError`` line for a store path the file system cannot hold: a folder name over its
+    name limit, or a path that leaves no room for the files jt keeps under it."""
+    probe = root
+    while probe != probe.parent:
+        try:
+            if probe.exists():
+                break
+        except OSError:  # ENAMETOOLONG: a part over the limit, said below
+            pass
+        probe = probe.parent
+    try:
+        name_max, path_max = os.pathconf(probe, "PC_NAME_MAX"), os.pathconf(probe, "PC_PATH_MAX")
+    except (OSError, ValueError):
+        name_max, path_max = 255, 4096
+    for part in root.parts:
+        if len(part.encode()) > name_max:
+            raise JtError(f"store=...{part[-30:]}: a folder name of {len(part.encode())} bytes; the file system takes "
+                          f"{name_max} at most: give a shorter store=")
+    if len(str(root).encode()) + INNER_PATH_BYTES > path_max:
+        raise JtError(f"store=...{str(root)[-30:]}: a path of {len(str(root).encode())} bytes leaves no room for the "
+                      f"files jt keeps under it ({INNER_PATH_BYTES} more; the file system takes {path_max}): give a "
+                      "shorter store=")
 
 
 @contextmanager

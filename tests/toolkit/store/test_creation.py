@@ -130,3 +130,12 @@ def test_partials_of_dead_processes_go_and_a_live_ones_stays(tmp_path):
     finally:
         live.kill()
         live.wait()
+
+
+def test_a_store_path_the_file_system_cannot_hold_is_one_line(tmp_path):
+    """A 300-character folder name, or a path with no room for the files under it, was an
+    internal error (OSError: File name too long); now one line, nothing made."""
+    for root in (tmp_path / ("a" * 300), tmp_path.joinpath(*["b" * 200] * 20)):
+        with pytest.raises(JtError, match="give a shorter store="):
+            Store(root)
+    assert sorted(tmp_path.iterdir()) == []
