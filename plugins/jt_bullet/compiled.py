@@ -2,7 +2,7 @@
 
 ``CompiledSteps`` packs what the loop needs once per simulator (the model's tables, the
 PyBullet-to-jt state maps, the SPD kernel and its workspaces, buffers) and each ``Watch`` into
-arrays, runs a control step's substeps in one call and turns the result into the simulator's step
+arrays, grouped in the tuples ``fastloop.substeps`` takes, runs a control step's substeps in one call and turns the result into the simulator's step
 record, the same one the Python loop builds. ``CompiledSteps.unavailable(sim)`` says why a
 simulator cannot use it (``sim.loop=python`` then, or the Python loop where ``sim.loop=auto``).
 """
@@ -54,7 +54,6 @@ class CompiledSteps:
         self.h, why = capi.handle(sim.client, sim.character.body_id)
         if not self.h:
             raise RuntimeError(why)
-        self.ok_state = capi.CMD_ACTUAL_STATE_UPDATE_COMPLETED
         self.ok_contact = capi.CMD_CONTACT_POINT_INFORMATION_COMPLETED
         m, be, body, kw = sim.model, sim.backend, sim.character.body_id, {"physicsClientId": sim.client}
         self.body = int(body)
@@ -93,16 +92,25 @@ class CompiledSteps:
         self.max_iter = int(getattr(be, "max_iter_factor", 20)) * m.n_v
         self.zeros = np.zeros(m.n_v)
         com = CenterOfMass(m)
-        self.c_parts = (com._mass, com._com, com._world, com._wb, com._sc)
         self.timers = np.zeros(4)
         self.iout = np.zeros(5, i64)
         self.fout = np.zeros(2)
+        d = self.data  # ``fastloop.substeps``' groups that stay the same for the body's life
+        self.api = (self.fns, self.h, self.body, self.ok_contact)
+        self.maps = (self.qmap, self.umap, self.j_uindex, self.j_start, self.j_count)
+        self.bufs = (self.bq, self.bu, self.holder, self.ts, self.cinfo, self.cinfo32, self.pts)
+        self.spd = (self.method, m.mi, m.mf, m.dof_parent, m.gravity, d.wb, d.wv, d.sc, d.H, d.A,
+                    self.zeros, self.tol, self.max_iter)
+        self.com = (com._mass, com._com, com._world, com._wb, com._sc)
+        self.out = (self.timers, self.iout, self.fout)
         self._watch: Optional[Watch] = None
         self._packed: tuple = ()
         self._n_links = sim.n_links
 
     def _pack(self, watch: Optional[Watch], n: int) -> tuple:
-        """The rule, touch and record arrays of ``watch`` (cached for the last watch seen)."""
+        """The rule, touch and record arrays of ``watch`` (cached for the last watch seen): ``(cap,
+        watch, substeps' watch group, its records group, touch bodies, time rows, CoM rows, root
+        rows)``, room for ``cap >= n`` records."""
         if watch is self._watch and self._packed and self._packed[0] >= n:
             return self._packed
         nl = self._n_links + 1
@@ -117,18 +125,18 @@ class CompiledSteps:
             for link in links:
                 if -1 <= link < nl - 1 and link not in rule.except_links:
                     mask[r, link + 1] = True
-        rules = (np.array([r.body for r in w.rules], np.int64), mask,
+        touches = np.array(w.touches, np.int64)
+        active = bool(w.rules or w.touches or w.record or w.time_limit is not None)
+        group = (max(1, int(w.check_every)), active, np.inf if w.time_limit is None else float(w.time_limit),
+                 np.array([r.body for r in w.rules], np.int64), mask,
                  np.array([r.outcome == "fail" for r in w.rules], np.bool_),
                  np.array([-1 if r.clear_of is None else int(r.clear_of) for r in w.rules], np.int64),
-                 np.array([float(r.margin) for r in w.rules]))
-        touches = np.array(w.touches, np.int64)
+                 np.array([float(r.margin) for r in w.rules]), touches)
         cap = max(n, 1)
         flags = np.array(["time" in w.record, "com" in w.record, "root" in w.record], np.bool_)
-        active = bool(w.rules or w.touches or w.record or w.time_limit is not None)
+        rows = (np.zeros(cap), np.zeros((cap, 3)), np.zeros((cap, 7)))
         self._watch = watch
-        self._packed = (cap, w, active, max(1, int(w.check_every)), rules, touches, flags,
-                        np.zeros(cap), np.zeros((cap, 3)), np.zeros((cap, 7)),
-                        np.inf if w.time_limit is None else float(w.time_limit))
+        self._packed = (cap, w, group, (flags, *rows), touches, *rows)
         return self._packed
 
     def read(self) -> tuple[np.ndarray, np.ndarray]:
@@ -167,8 +175,8 @@ class CompiledSteps:
              watch: Optional[Watch]) -> tuple[int, dict[str, Any]]:
         """Run ``n`` substeps towards ``qt``; ``(substeps done, the watch's result)`` with the
         simulator's time, failure, state (``sim.io.q``, ``sim.io.qd``) and torques updated."""
-        sim, be, m = self.sim, self.sim.backend, self.sim.model
-        cap, w, active, every, rules, touches, flags, r_time, r_com, r_root, t_lim = self._pack(watch, n)
+        sim, be = self.sim, self.sim.backend
+        _cap, w, group, records, touches, r_time, r_com, r_root = self._pack(watch, n)
         touched = np.zeros((len(touches), self._n_links + 1), np.bool_)
         touched_any = np.zeros(len(touches), np.bool_)
         d = self.data
@@ -176,15 +184,10 @@ class CompiledSteps:
         if self.method == self.fl.SERVO:
             be.apply(qt, sim.kp, sim.kd, sim.torque_limit, vt)  # the motors hold it through the substeps
         self.fl.substeps(
-            self.fns, self.h, self.body, int(n), every, active, qt,
-            self.zeros if vt is None else vt, sim.kp, sim.kd, sim.torque_limit, sim.dt, sim.time,
-            m.mi, m.mf, m.dof_parent, m.gravity, d.wb, d.wv, d.sc, d.H, d.A, self.zeros,
-            self.method, self.tol, self.max_iter, self.qmap, self.umap, self.j_uindex,
-            self.j_start, self.j_count, io.q, io.qd, self.bq, self.bu, self.holder, self.ts,
-            self.cinfo, self.cinfo32, self.pts, self.ok_state, self.ok_contact,
-            float(sim.params.explode_speed), sim._explode_d2, bool(sim.character.fixed_base),
-            *rules, touches, touched, touched_any, r_time, r_com, r_root, flags, *self.c_parts,
-            t_lim, self.timers, self.iout, self.fout)
+            self.api, self.maps, self.bufs, self.spd, self.com, group, records, int(n), sim.time,
+            (qt, self.zeros if vt is None else vt, sim.kp, sim.kd, sim.torque_limit, sim.dt),
+            (float(sim.params.explode_speed), sim._explode_d2, bool(sim.character.fixed_base)),
+            io.q, io.qd, touched, touched_any, self.out)
         done, fail, fired, n_rec, its = (int(x) for x in self.iout)
         sim.time = float(self.fout[0])
         if self.method == 2:

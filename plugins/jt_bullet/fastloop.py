@@ -229,17 +229,55 @@ def _near(fns, h, body, other, margin, cinfo, cinfo32, ok_status) -> bool:
 
 
 @njit(cache=True)
-def substeps(fns, h, body, n, every, active, qt, qdt, kp, kd, lim, dt, t,
-             mi, mf, lam, grav, wb, wv, sc, H, A, zeros, method, tol, max_iter,
-             qmap, umap, j_uindex, j_start, j_count, q, qd, bq, bu, holder, ts,
-             cinfo, cinfo32, pts, ok_state, ok_contact,
-             explode_speed, explode_d2, fixed_base,
-             rule_body, rule_mask, rule_fail, rule_clear, rule_margin,
-             touch_body, touched, touched_any, rec_time, rec_com, rec_root, rec_flags,
-             c_mass, c_com, c_world, c_wb, c_sc, time_limit, timers, iout, fout) -> None:
+def substeps(api, maps, bufs, spd, com, watch, records, n, t, control, checks, q, qd, touched,
+             touched_any, out) -> None:
     """Run up to ``n`` substeps (see the module docstring); results in ``q``, ``qd``, ``wv[V_TAU]``
     (the last clipped torques), ``iout``, ``fout`` (``[time, max |qd|]``), ``touched`` and the
-    ``rec_*`` rows, timings added to ``timers``."""
+    ``rec_*`` rows, timings added to ``timers``.
+
+    The arrays come grouped in plain tuples (``CompiledSteps`` builds those of a body once, those
+    of a ``Watch`` once per watch): numba's dispatcher types a tuple of arrays as fast as the same
+    arrays given flat (a ``NamedTuple`` would take twice as long), and unpacking them here costs
+    nothing in the compiled code, which is the same loop on the same doubles.
+
+    Args:
+        api: ``(fns, h, body, ok_contact)``: the C functions' addresses (``funcs()``), the physics
+            client's handle, the body's unique id, and the status of a completed contact query.
+        maps: ``(qmap, umap, j_uindex, j_start, j_count)`` int64: PyBullet's q / u index of each jt
+            coordinate, and per joint its u index, first jt dof and dof count (torque commands).
+        bufs: ``(bq, bu, holder, ts, cinfo, cinfo32, pts)``: PyBullet's q and u, the state's
+            pointers, a ``timespec``, the contact info (int64 and its int32 view), contact points.
+        spd: ``(method, mi, mf, lam, grav, wb, wv, sc, H, A, zeros, tol, max_iter)``: the SPD kernel
+            (``MABA``, ``DF``, ``SF``, ``PCG``, ``SERVO``), the model's tables, dof parents and
+            gravity, the kernel's workspaces, zeros ``(n_v,)``, PCG's tolerance and iteration cap.
+        com: ``(c_mass, c_com, c_world, c_wb, c_sc)``: ``com_kernel``'s tables and workspaces.
+        watch: ``(every, active, time_limit, rule_body, rule_mask, rule_fail, rule_clear,
+            rule_margin, touch_body)``: check every ``every``-th substep (only if ``active``), end
+            at ``time_limit``; per contact rule its other body, character links ``(n_links + 1,)``,
+            whether it fails, the body to be clear of (-1: none) and by what margin; the bodies
+            whose first touches are wanted.
+        records: ``(rec_flags, rec_time, rec_com, rec_root)``: which of time, CoM, root to record,
+            and their rows.
+        n: substeps to run at most.
+        t: the simulator's time at the start (s).
+        control: ``(qt, qdt, kp, kd, lim, dt)``: SPD targets, gains, torque limits, substep (s).
+        checks: ``(explode_speed, explode_d2, fixed_base)``: the explosion check's bounds.
+        q: ``(n_q,)``, filled with the state at the end.
+        qd: ``(n_v,)``, likewise.
+        touched: ``(n_touch, n_links + 1)`` bool, the links that touched each ``touch_body``.
+        touched_any: ``(n_touch,)`` bool, whether any did.
+        out: ``(timers, iout, fout)``: timings (``T_*``), results (``I_*``), time and max ``|qd|``.
+    """
+    fns, h, body, ok_contact = api
+    qmap, umap, j_uindex, j_start, j_count = maps
+    bq, bu, holder, ts, cinfo, cinfo32, pts = bufs
+    method, mi, mf, lam, grav, wb, wv, sc, H, A, zeros, tol, max_iter = spd
+    c_mass, c_com, c_world, c_wb, c_sc = com
+    every, active, time_limit, rule_body, rule_mask, rule_fail, rule_clear, rule_margin, touch_body = watch
+    rec_flags, rec_time, rec_com, rec_root = records
+    qt, qdt, kp, kd, lim, dt = control
+    explode_speed, explode_d2, fixed_base = checks
+    timers, iout, fout = out
     tau = wv[V_TAU]
     nv = qd.shape[0]
     nr = rule_body.shape[0]

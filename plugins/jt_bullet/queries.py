@@ -101,16 +101,6 @@ class SceneQueries:
             fk = self._com_fk = CenterOfMass(self.model)
         return fk(q)
 
-    def link_positions(self) -> tuple[np.ndarray, tuple, tuple]:
-        """Centre-of-mass positions ``(n_links + 1, 3)`` of the base and every link, with the base's
-        position and orientation as PyBullet returned them (the hot path of ``Watch.record``)."""
-        import pybullet as pb
-
-        kw, b = {"physicsClientId": self.client}, self.character.body_id
-        pos, orn = pb.getBasePositionAndOrientation(b, **kw)
-        states = pb.getLinkStates(b, self._link_ids, **kw)
-        return np.array([pos, *[s[0] for s in states]]), pos, orn
-
     def link_pose(self, link: int) -> tuple[np.ndarray, np.ndarray]:
         """World position ``(3,)`` and orientation x, y, z, w ``(4,)`` of a link's URDF frame
         (-1: the base frame)."""

@@ -18,6 +18,8 @@ import hashlib
 import os
 from pathlib import Path
 
+from toolkit.store import atomic
+
 SNAKE_SEGMENT = {"length": 0.1, "width": 0.04, "mass": 0.5}
 
 
@@ -34,9 +36,7 @@ def write_cached(stem: str, text: str) -> str:
     digest = hashlib.sha256(text.encode()).hexdigest()[:12]
     path = cache_dir() / f"{stem}-{digest}.urdf"
     if not path.exists():
-        tmp = path.with_suffix(f".tmp{os.getpid()}")
-        tmp.write_text(text)
-        os.replace(tmp, path)
+        atomic.write_text(path, text)
     return str(path)
 
 

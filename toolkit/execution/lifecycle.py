@@ -26,6 +26,7 @@ from toolkit.errors import JtError
 from toolkit.execution import describe
 from toolkit.execution.heartbeat import Heartbeat, check_not_owned
 from toolkit.execution.lock import RunLock
+from toolkit.store import atomic
 from toolkit.store.tracking import Store
 
 STAGED_TAG = "jt.config_staged"
@@ -35,17 +36,6 @@ CONFIG_NAME = "config.yaml"
 
 def _staged_path(store: Store, token: str) -> Path:
     return store.workdir("_new") / f"{token}.yaml"
-
-
-def _write_atomically(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through ``<path>.tmp-<pid>`` and a rename (no half file, no temp left)."""
-    tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
-    try:
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
 def _remove_temp_files(workdir: Path) -> None:
@@ -89,7 +79,7 @@ def complete_opening(store: Store, run_id: str, cfg: Any, run: Any = None) -> No
         if src is not None:
             os.replace(src, dst)
         else:
-            _write_atomically(dst, to_yaml(cfg))
+            atomic.write_text(dst, to_yaml(cfg))
     if run is None:  # a new run: everything, as composed
         store.log_params(run_id, flatten(cfg))
         store.log_artifact(run_id, dst)
@@ -147,7 +137,7 @@ def open_run(store: Store, cfg: Any, experiment: str, command: str, task_cls: An
         return rid, True, lock
     describe.ensure_experiment(store, experiment, task_cls)
     token = uuid.uuid4().hex
-    _write_atomically(_staged_path(store, token), to_yaml(cfg))  # before the row: resumable at once
+    atomic.write_text(_staged_path(store, token), to_yaml(cfg))  # before the row: resumable at once
     tags = {
         **describe.provenance_tags(command),
         "jt.seed": str(cfg.seed),

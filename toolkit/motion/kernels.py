@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-_SMALL = 1e-6  # rotations._SMALL
+from toolkit.motion.rotations import SMALL
 
 
 @njit(cache=True)
@@ -39,7 +39,7 @@ def dofs_to_joints(dofs: np.ndarray, sph_dof: np.ndarray, sph_q: np.ndarray, rev
     for s in range(sph_dof.shape[0]):
         v0, v1, v2 = dofs[sph_dof[s, 0]], dofs[sph_dof[s, 1]], dofs[sph_dof[s, 2]]
         theta = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-        if theta < _SMALL:
+        if theta < SMALL:
             scale = 0.5 - theta * theta / 48.0
         else:
             scale = math.sin(0.5 * theta) / theta

@@ -22,8 +22,12 @@ import math
 
 import numpy as np
 
-_EPS = 1e-12
-_SMALL = 1e-6  # below this |v| (or half-angle sine) a Taylor series replaces the closed form
+EPS = 1e-12
+"""Below this norm a vector or quaternion counts as zero (no direction to normalise to)."""
+SMALL = 1e-6
+"""Below this angle ``|v|`` (or half-angle sine) a Taylor series replaces the closed form. The
+compiled kernels (``toolkit.motion.kernels``, the spacetime and get-up envs' ``kernels``) import
+both constants from here, so they take the same branches as the numpy functions."""
 
 
 def _arr(x) -> np.ndarray:
@@ -43,10 +47,10 @@ def quat_normalize(q) -> np.ndarray:
     if q.shape == (4,):  # one quaternion: Python floats, the same bits (see _quat_to_matrix_one)
         x, y, z, w = q.tolist()
         n = math.sqrt(x * x + y * y + z * z + w * w)
-        return np.array([x / n, y / n, z / n, w / n] if n > _EPS else [0.0, 0.0, 0.0, 1.0])
+        return np.array([x / n, y / n, z / n, w / n] if n > EPS else [0.0, 0.0, 0.0, 1.0])
     n = np.linalg.norm(q, axis=-1, keepdims=True)
-    out = q / np.maximum(n, _EPS)
-    return np.where(n > _EPS, out, quat_identity(q.shape[:-1]))
+    out = q / np.maximum(n, EPS)
+    return np.where(n > EPS, out, quat_identity(q.shape[:-1]))
 
 
 def quat_canonical(q) -> np.ndarray:
@@ -131,7 +135,7 @@ def quat_from_expmap(v) -> np.ndarray:
     """
     v = _arr(v)
     theta = np.linalg.norm(v, axis=-1, keepdims=True)
-    small = theta < _SMALL
+    small = theta < SMALL
     safe = np.where(small, 1.0, theta)
     scale = np.where(small, 0.5 - theta**2 / 48.0, np.sin(0.5 * safe) / safe)
     return np.concatenate([v * scale, np.cos(0.5 * theta)], axis=-1)
@@ -146,7 +150,7 @@ def quat_to_expmap(q) -> np.ndarray:
     q = quat_canonical(quat_normalize(q))
     u, w = q[..., :3], q[..., 3:4]
     s = np.linalg.norm(u, axis=-1, keepdims=True)
-    small = s < _SMALL
+    small = s < SMALL
     safe = np.where(small, 1.0, s)
     # angle = 2 atan2(s, w); angle / s -> 2 / w (1 - s^2 / (3 w^2)) as s -> 0 (w ~ 1 there)
     scale = np.where(small, (2.0 / w) * (1.0 - s**2 / (3.0 * w**2)), 2.0 * np.arctan2(s, w) / safe)
@@ -161,7 +165,7 @@ def quat_from_axis_angle(axis, angle) -> np.ndarray:
     """Quaternions ``(..., 4)`` from axes ``(..., 3)`` (normalised here) and angles ``(...)``."""
     axis = _arr(axis)
     n = np.linalg.norm(axis, axis=-1, keepdims=True)
-    axis = axis / np.maximum(n, _EPS)
+    axis = axis / np.maximum(n, EPS)
     half = 0.5 * _arr(angle)[..., None]
     xyz = axis * np.sin(half)
     w = np.broadcast_to(np.cos(half), xyz.shape[:-1] + (1,))
@@ -173,7 +177,7 @@ def quat_to_axis_angle(q) -> tuple[np.ndarray, np.ndarray]:
     v = quat_to_expmap(q)
     angle = np.linalg.norm(v, axis=-1)
     axis = np.where(
-        angle[..., None] > _EPS, v / np.maximum(angle, _EPS)[..., None], np.array([1.0, 0.0, 0.0])
+        angle[..., None] > EPS, v / np.maximum(angle, EPS)[..., None], np.array([1.0, 0.0, 0.0])
     )
     return axis, angle
 
@@ -221,7 +225,7 @@ def _quat_to_matrix_one(q: np.ndarray) -> np.ndarray:
     per-call overhead on 4 numbers)."""
     x, y, z, w = q.tolist()
     n = math.sqrt(x * x + y * y + z * z + w * w)
-    if n > _EPS:
+    if n > EPS:
         x, y, z, w = x / n, y / n, z / n, w / n
     else:
         x, y, z, w = 0.0, 0.0, 0.0, 1.0
@@ -273,13 +277,13 @@ def sixd_to_matrix(d6) -> np.ndarray:
     d6 = _arr(d6)
     a1, a2 = d6[..., :3], d6[..., 3:]
     n1 = np.linalg.norm(a1, axis=-1, keepdims=True)
-    b1 = np.where(n1 > _EPS, a1 / np.maximum(n1, _EPS), [1.0, 0.0, 0.0])
+    b1 = np.where(n1 > EPS, a1 / np.maximum(n1, EPS), [1.0, 0.0, 0.0])
     b2 = a2 - np.sum(b1 * a2, axis=-1, keepdims=True) * b1
     n2 = np.linalg.norm(b2, axis=-1, keepdims=True)
     # degenerate second column: use a unit vector orthogonal to b1
     alt = np.cross(b1, np.where(np.abs(b1[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]))
     alt = alt / np.linalg.norm(alt, axis=-1, keepdims=True)
-    b2 = np.where(n2 > 1e-9, b2 / np.maximum(n2, _EPS), alt)
+    b2 = np.where(n2 > 1e-9, b2 / np.maximum(n2, EPS), alt)
     b3 = np.cross(b1, b2)
     return np.stack([b1, b2, b3], axis=-1)
 

@@ -148,16 +148,6 @@ def _find(ref: str, store_root: Optional[str], kind: str) -> Path:
                    hint=how_to_make(kind), accept=_is_prior_file).path
 
 
-def find_prior(ref: str, store_root: Optional[str] = None, kind: str = "pvae") -> Path:
-    """The prior file that ``action.prior=ref`` names (a file, a folder or a run id), without
-    loading it: for checks before a run opens.
-
-    Raises:
-        JtError: one line, ending with how to make a prior.
-    """
-    return _find(str(ref).strip(), store_root, kind)
-
-
 def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] = None) -> PosePrior:
     """Load a prior from a file path, a folder holding one, or the id of the MLflow run that made it.
 

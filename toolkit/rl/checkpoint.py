@@ -16,9 +16,10 @@ lists, arrays, tensors and scalars losslessly and reads them back with their typ
     attrs: config (JSON of PPOConfig), obs_dim, act_dim, low, high, format, and warm_start
            (the checkpoint a warm-started run started from) if any
 
-``save`` writes ``path.tmp``, fsyncs it and ``os.replace``s it onto ``path``, so a crash never
-leaves a half-written checkpoint behind. (``toolkit.store.h5`` is not used: it reads back plain
-numpy dicts, while optimiser states need int keys, tuples, None and tensors back exactly.)
+``save`` writes ``<path>.tmp-<pid>``, fsyncs it and ``os.replace``s it onto ``path``
+(``toolkit.store.atomic``), so a crash never leaves a half-written checkpoint behind.
+(``toolkit.store.h5`` is not used: it reads back plain numpy dicts, while optimiser states need
+int keys, tuples, None and tensors back exactly.)
 
 The training glue (what ``toolkit.rl.ppo.train`` saves, resumes and warm-starts from) is at the
 end: ``save_training``, ``load_training``, ``load_networks``, and for warm starts
@@ -36,6 +37,8 @@ from typing import TYPE_CHECKING, Any, Optional
 import h5py
 import numpy as np
 import torch
+
+from toolkit.store.atomic import atomic_write
 
 if TYPE_CHECKING:
     from toolkit.rl.config import PPOConfig
@@ -134,17 +137,13 @@ def save(path: str | os.PathLike, groups: dict[str, Any], attrs: dict[str, Any])
         The written path.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    with h5py.File(tmp, "w", track_order=True) as f:
-        f.attrs["format"] = FORMAT
-        for k, v in attrs.items():
-            f.attrs[k] = json.dumps(v) if isinstance(v, (dict, list)) else v
-        for name, tree in groups.items():
-            write_tree(f, name, tree)
-    with open(tmp, "rb") as fh:  # on disk before the rename
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    with atomic_write(path) as tmp:
+        with h5py.File(tmp, "w", track_order=True) as f:
+            f.attrs["format"] = FORMAT
+            for k, v in attrs.items():
+                f.attrs[k] = json.dumps(v) if isinstance(v, (dict, list)) else v
+            for name, tree in groups.items():
+                write_tree(f, name, tree)
     return path
 
 

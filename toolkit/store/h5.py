@@ -1,7 +1,7 @@
 """HDF5 artifacts: nested dicts of arrays written atomically (temp file + rename).
 
 An interrupted write never leaves a truncated file: data goes to ``<name>.tmp-<pid>`` in the same
-directory, is flushed and fsynced, then renamed over the target with ``os.replace``.
+directory, is flushed and fsynced, then renamed over the target (``toolkit.store.atomic``).
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ from typing import Any, Mapping
 
 import h5py
 import numpy as np
+
+from toolkit.store.atomic import atomic_write
 
 
 def _write_group(g: "h5py.Group", data: Mapping[str, Any]) -> None:
@@ -43,20 +45,12 @@ def write(path: str | os.PathLike, data: Mapping[str, Any], attrs: Mapping[str, 
         The path written.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
-    try:
+    with atomic_write(path) as tmp:
         with h5py.File(tmp, "w") as f:
             for k, v in (attrs or {}).items():
                 f.attrs[str(k)] = v if isinstance(v, (int, float, str, np.ndarray)) else str(v)
             _write_group(f, data)
             f.flush()
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
     return path
 
 

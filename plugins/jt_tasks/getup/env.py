@@ -3,11 +3,11 @@
 An episode: a feature curve (``curves.FeatureCurve``) and an initial state (``003`` §5.2): the
 curve's clip's first pose, a settled rag-doll state (a curve whose start torso angles are within
 30° of it), or a standing pose (the curve then starts at ``s = 1``, the standing phase). It lasts
-``T + T_stand`` (3 s, §5.6) and ends early (§5.3) when ``r_task < 0.1`` or the head touches the
-ground for more than 300 ms in a row (head contacts count only after ``head_grace`` s when the
-head lies on the floor, or within 15 cm of it, at t = 0: supine clip starts and rag-doll states).
-``info["success"]`` counts fallen starts only (standing starts: ``standing_success``), so the
-terrain curriculum counts get-ups. Control at the simulator's ``control_hz`` (30 Hz,
+``T + T_stand`` (3 s, §5.6) and ends early (§5.3) when ``r_task < r_task_min`` (0.1) or the head
+touches the ground for more than 300 ms in a row (head contacts count only after ``head_grace`` s
+when the head lies on the floor, or within 15 cm of it, at t = 0: supine clip starts and rag-doll
+states). ``info["success"]`` counts fallen starts only (standing starts: ``standing_success``), so
+the terrain curriculum counts get-ups. Control at the simulator's ``control_hz`` (30 Hz,
 §5.6), ``sim_hz / control_hz`` substeps (600 Hz here; 003 simulates at 60 Hz).
 
 Reward per control step: ``r = r_task · r_natural`` (eq 2), the product of the ``reward`` group's
@@ -365,7 +365,7 @@ class GetupEnv(CharacterEnv):
                          "target_theta_z": record["target_theta_z"], "head_contact": float(head)})
         reason = ""
         if self.low_t > spec.sustain + 1e-9:
-            reason = "r_task < 0.1"
+            reason = f"r_task < {spec.r_task_min:g}"
         elif self.head_t > spec.sustain + 1e-9:
             reason = "head on the floor"
         if reason:

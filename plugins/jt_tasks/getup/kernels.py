@@ -17,9 +17,7 @@ import numpy as np
 from numba import njit
 
 from toolkit.motion.kernels import quat_mul
-
-EPS = 1e-12  #: rotations._EPS: below this norm a vector / quaternion counts as zero
-SMALL = 1e-6  #: rotations._SMALL: below this half-angle sine the log map uses its series
+from toolkit.motion.rotations import EPS, SMALL  # below EPS a norm is zero; below SMALL the log map's series
 
 
 @njit(cache=True)

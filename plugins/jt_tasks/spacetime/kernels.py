@@ -19,9 +19,7 @@ import numpy as np
 from numba import njit
 
 from toolkit.motion.kernels import quat_mul
-
-_EPS = 1e-12
-_SMALL = 1e-6
+from toolkit.motion.rotations import EPS, SMALL
 
 
 @njit(cache=True)
@@ -89,15 +87,15 @@ def sample(i: int, f: float, held: bool, cos_a: float, sin_a: float, p0: np.ndar
     for r in range(q0.shape[1]):
         v0, v1, v2 = log[i, r, 0] * f, log[i, r, 1] * f, log[i, r, 2] * f
         theta = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-        if theta < _SMALL:
+        if theta < SMALL:
             scale = 0.5 - theta * theta / 48.0  # numpy squares by multiplying
         else:
             scale = math.sin(0.5 * theta) / theta
         bx, by, bz, bw = v0 * scale, v1 * scale, v2 * scale, math.cos(0.5 * theta)
         x, y, z, w = quat_mul(q0[i, r, 0], q0[i, r, 1], q0[i, r, 2], q0[i, r, 3], bx, by, bz, bw)
         n = math.sqrt(x * x + y * y + z * z + w * w)
-        if n > _EPS:
-            m = max(n, _EPS)
+        if n > EPS:
+            m = max(n, EPS)
             x, y, z, w = x / m, y / m, z / m, w / m
         else:
             x, y, z, w = 0.0, 0.0, 0.0, 1.0

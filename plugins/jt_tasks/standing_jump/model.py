@@ -26,6 +26,8 @@ import tempfile
 from pathlib import Path
 from typing import Optional
 
+from toolkit.store import atomic
+
 # de Leva 1996 Table 4 (males), reference stature 1741 mm:
 #            length_mm, mass_fraction, com_fraction_from_proximal, radius_of_gyration_sagittal
 DE_LEVA = {
@@ -278,9 +280,7 @@ def write_urdf(body: Body, rgba: tuple[float, float, float, float] = (0.55, 0.36
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"planar_humanoid_{digest}.urdf"
     if not path.exists():
-        tmp = folder / f".{path.name}.{os.getpid()}.tmp"
-        tmp.write_text(text)
-        os.replace(tmp, path)
+        atomic.write_text(path, text)
     return path
 
 

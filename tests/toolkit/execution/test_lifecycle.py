@@ -18,6 +18,7 @@ def _killed_at_row_birth(tmp_path):
     from toolkit import plugins
     from toolkit.config import compose, to_yaml
     from toolkit.execution import describe, lifecycle
+    from toolkit.store import atomic
     from toolkit.store.tracking import Store
 
     store_dir = tmp_path / "store"
@@ -25,7 +26,7 @@ def _killed_at_row_birth(tmp_path):
     store = Store(str(store_dir))
     describe.ensure_experiment(store, "zdt1", plugins.load("task", "zdt1"))
     token = "a" * 32
-    lifecycle._write_atomically(lifecycle._staged_path(store, token), to_yaml(cfg))
+    atomic.write_text(lifecycle._staged_path(store, token), to_yaml(cfg))
     rid = store.start_run("zdt1", run_name="zdt1·random·seed0",
                           tags={lifecycle.STAGED_TAG: token, "jt.task": "zdt1", "jt.search": str(cfg.search.name)})
     return store, rid, token

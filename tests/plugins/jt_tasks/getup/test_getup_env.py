@@ -82,6 +82,24 @@ def test_reward_is_the_product_and_episode_ends_with_info(env):
     assert 0.0 <= info["task_return_rate"] <= 1.0 and info["success"] in (0.0, 1.0)
 
 
+def test_the_early_termination_reason_names_the_configured_threshold():
+    from toolkit import plugins
+    from toolkit.config import compose, validate
+
+    cfg = validate(compose(["task=getup", "action=raw", "task.n_fallen=2", "task.r_task_min=0.99"]))
+    e = plugins.load("task", "getup")(cfg).make_env(None, seed=0)
+    try:
+        e.reset(seed=0, options={"kind": "clip", "curve": "facedown"})
+        done, info = False, {}
+        while not done:
+            _, _, te, tr, info = e.step(np.zeros(e.action_space.shape, np.float32))
+            done = te or tr
+        assert te and info["reason"] == "r_task < 0.99"  # not the default's "r_task < 0.1"
+        assert all(row["r_task"] < 0.99 for row in e.log[-10:])
+    finally:
+        e.close()
+
+
 @pytest.mark.parametrize("override, match", [
     ("task.curves=[nope]", "unknown curve"),
     ("task.fallen_styles=[sideways]", "fallen_styles"),
