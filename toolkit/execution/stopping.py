@@ -5,7 +5,7 @@ happens to be, inside a weakref callback (where Python prints it and swallows it
 on to FINISHED) or halfway through an MLflow/SQLite write (``database is locked``, the run left
 RUNNING). So ``Terminate`` only records the request, and the run stops at its next safe point by
 calling ``check()``: between evaluations and store writes (the runner), after each PPO iteration
-(``toolkit.rl.ppo``), between episodes of a final evaluation (``toolkit.policy.train.rollout``),
+(``toolkit.rl.ppo``), between episodes of a final evaluation (``toolkit.policy.episodes.rollout``),
 while the local executor waits for its workers. ``check()`` raises ``KeyboardInterrupt`` with the
 reason, which the runner turns into a KILLED run (exit 130, resumable). A second SIGTERM while
 the first is pending raises at once (a run stuck somewhere can still be stopped).

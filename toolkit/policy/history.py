@@ -4,8 +4,11 @@
 ``(samples, value, ...)``, each value a mean over the iteration's finished episodes (their final
 ``info``) or anything the task computes; the rows live in PPO's ``extra`` under the task's key, so
 they are checkpointed in ``ppo.h5`` and a resumed run continues the curve. It also draws the
-evaluation's progress line with the task's key figure. ``base_metrics``, ``numbers`` and
-``finite`` are the metric plumbing every task's ``measure`` shares.
+evaluation's progress line with the task's key figure. ``measured`` is what every task's
+``measure`` starts from: its own metrics, the ones every policy task reports (``base_metrics``:
+the deterministic rollout's return and PPO's counters), only the finite ones, and the training
+curve (``mean_return``) beside the task's curves; ``numbers`` and ``finite`` are the rest of the
+metric plumbing.
 
 Usage, in a task's ``training`` hook::
 
@@ -14,6 +17,12 @@ Usage, in a task's ``training`` hook::
     hooks = Hooks(on_iteration=hist.on_iteration, extra=extra)
     ...
     hist.curves(result.extra, {"r_goal": "goal_reward"})   # in measure: {name: [(samples, v)]}
+
+and in its ``measure``::
+
+    metrics, history = measured(ro, trained, {"goal_reward": ro.info["r_goal"]},
+                                hist.curves(trained.result.extra))
+    return Evaluation(metrics=metrics, history=history)
 """
 
 from __future__ import annotations
@@ -39,11 +48,11 @@ def finite(metrics: Mapping[str, float]) -> dict[str, float]:
     return {k: float(v) for k, v in metrics.items() if math.isfinite(float(v))}
 
 
-def base_metrics(ro: Mapping[str, Any], trained: Any) -> dict[str, float]:
+def base_metrics(ro: Any, trained: Any) -> dict[str, float]:
     """The metrics every policy task reports: the deterministic rollout's return and PPO's counters.
 
     Args:
-        ro: the rollout (``toolkit.policy.train.rollout``), its ``return``.
+        ro: the deterministic rollout (``toolkit.policy.episodes.Rollout``), its ``return_``.
         trained: ``toolkit.policy.train.Trained``.
 
     Returns:
@@ -53,10 +62,34 @@ def base_metrics(ro: Mapping[str, Any], trained: Any) -> dict[str, float]:
     from toolkit.policy.train import last_finite
 
     res = trained.result
-    return {"mean_return": float(ro["return"]),
+    return {"mean_return": float(ro.return_),
             "train_mean_return": last_finite(res.history.get("mean_return", [])),
             "samples": float(res.samples), "iterations": float(res.iterations),
             "samples_per_s": float(trained.samples_per_s), "train_wall_s": float(trained.wall_s)}
+
+
+def measured(ro: Any, trained: Any, metrics: Mapping[str, float],
+             curves: Optional[Mapping[str, list]] = None,
+             keep_nonfinite: bool = False) -> tuple[dict[str, float], dict[str, list]]:
+    """A policy task's metrics and curves: its own, then what every policy task reports.
+
+    Args:
+        ro: the deterministic rollout (``toolkit.policy.episodes.Rollout``).
+        trained: ``toolkit.policy.train.Trained``.
+        metrics: the task's own metrics (first, in their order: the progress line shows the
+            first few).
+        curves: the task's own curves ``{name: [(samples, value, ...)]}`` (None: none).
+        keep_nonfinite: keep nan / inf metrics (default: ``finite`` drops them).
+
+    Returns:
+        ``(metrics, history)``: ``metrics`` followed by ``base_metrics(ro, trained)``, finite
+        only unless ``keep_nonfinite``; ``history`` is ``mean_return`` (``return_curve``, the
+        training curve against samples) followed by ``curves``.
+    """
+    from toolkit.policy.train import return_curve
+
+    out = {**metrics, **base_metrics(ro, trained)}
+    return (out if keep_nonfinite else finite(out)), {"mean_return": return_curve(trained), **dict(curves or {})}
 
 
 class IterationHistory:

@@ -12,6 +12,14 @@ training curves. A task subclass says only what is its own:
   ``final_env(env, hooks)`` / ``final_options(env)``: the deterministic rollout's set-up;
   ``record(env)``: what to log per control step; ``rollout_data(ro, env, spec)``: what
   ``rollout.h5`` holds besides ``time``, ``root`` and ``com``; and ``measure(...)``: the metrics.
+  The hooks read the deterministic episode as a ``policy.episodes.Rollout`` (``ro``).
+
+What the hooks of every task share is in ``toolkit.policy`` too: ``sample_budget(ctx)`` (the
+evaluation's PPO budget, for progress fractions), ``episodes.rollout`` / ``episodes.opened_env``
+(one more deterministic episode, an env closed however the block ends),
+``periodic.PeriodicEvaluation`` (an evaluation every few iterations, kept in ``ppo.h5``),
+``history.IterationHistory`` (a per-iteration training curve) and ``history.measured`` (the
+metrics and curves every task reports beside its own).
 
 A task constructed without a config (``Task(None)``) composes its own defaults
 (``jt run task=<name>``), so every group it reads exists.
@@ -27,6 +35,7 @@ from toolkit.config import group_of, plain, task_params
 from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
 from toolkit.policy import train as tr
+from toolkit.policy.episodes import Rollout, opened_env, rollout
 
 
 def require_character_and_prior(cfg: Any, task: str, character: str, why: str) -> None:
@@ -69,11 +78,8 @@ def check_policy_fits(cfg: Any, task: str, path: Path) -> None:
 
     attrs = load_attrs(path)
     want = (int(attrs["obs_dim"]), int(attrs["act_dim"]))
-    env = plugins.load("task", task)(cfg).make_env(seed=0)
-    try:
+    with opened_env(plugins.load("task", task)(cfg).make_env, seed=0) as env:
         have = (int(env.observation_space.shape[0]), int(env.action_space.shape[0]))
-    finally:
-        env.close()
     if want != have:
         ref = str(group_of(group_of(cfg, "task"), "evaluate")).strip()
         raise JtError(f"task.evaluate={ref}: its policy takes {want[0]} observations and gives {want[1]} actions; "
@@ -172,7 +178,7 @@ class PolicyTask(Task):
         """Reset options of the deterministic rollout."""
         return None
 
-    def retry_rollout(self, env: Any, ro: dict) -> bool:
+    def retry_rollout(self, env: Any, ro: Rollout) -> bool:
         """After a deterministic rollout ``ro``: True to roll out again, after changing ``env`` (e.g.
         an easier curriculum level). Default: never."""
         return False
@@ -182,15 +188,22 @@ class PolicyTask(Task):
         q, _ = env.sim.state()
         return {"root": q[:7].copy(), "com": env.links_and_com()[1], "time": float(getattr(env, "t", env.sim.time))}
 
-    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
-        """``(datasets, attributes)`` of ``rollout.h5`` besides ``time``, ``root`` and ``com``."""
-        return {}, {"return": float(ro["return"]), "reason": str(ro["info"].get("reason", ""))}
+    def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
+        """``(datasets, attributes)`` of ``rollout.h5`` besides ``time``, ``root`` and ``com``; what
+        ``measure`` needs from the env after the episode goes to ``ro.notes``."""
+        return {}, {"return": float(ro.return_), "reason": str(ro.info.get("reason", ""))}
 
-    def measure(self, spec: Any, ro: dict, trained: tr.Trained, hooks: Hooks, workdir: Path) -> Evaluation:
+    def measure(self, spec: Any, ro: Rollout, trained: tr.Trained, hooks: Hooks, workdir: Path) -> Evaluation:
         """The evaluation's metrics from the deterministic rollout and the training."""
-        from toolkit.policy.history import base_metrics
+        from toolkit.policy.history import measured
 
-        return Evaluation(metrics=base_metrics(ro, trained), history={"mean_return": tr.return_curve(trained)})
+        metrics, history = measured(ro, trained, {}, keep_nonfinite=True)
+        return Evaluation(metrics=metrics, history=history)
+
+    def sample_budget(self, ctx: EvalContext) -> int:
+        """The evaluation's PPO budget: ``agent.total_samples`` of the ``agent`` group with the
+        evaluation's seed (what the progress fractions of the training hooks divide by)."""
+        return int(tr.agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples)
 
     # ------------------------------------------------------------------ shared wiring
     @property
@@ -229,20 +242,17 @@ class PolicyTask(Task):
                                   self._adopt_trained(workdir))
         model = load_policy(trained.checkpoint)
         outer.report(TRAIN_SHARE, "final rollout")
-        env = self.env_class(spec, seed=ctx.seed)
-        try:
+        with opened_env(self.env_class, spec, seed=ctx.seed) as env:
             self.final_env(env, hooks, trained)
             while True:
-                ro = tr.rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width,
-                                p.filmstrip_height, self.final_options(env))
+                ro = rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width,
+                             p.filmstrip_height, self.final_options(env))
                 if not self.retry_rollout(env, ro):
                     break
             data, attrs = self.rollout_data(ro, env, spec)
             fps = float(env.control_hz)
-        finally:
-            env.close()
-        written = tr.save_motion(workdir, ro["frames"], p.filmstrip_frames, fps)
-        h5.write(workdir / "rollout.h5", {"time": ro["time"], "root": ro["root"], "com": ro["com"], **data}, attrs)
+        written = tr.save_motion(workdir, ro.frames, p.filmstrip_frames, fps)
+        h5.write(workdir / "rollout.h5", {"time": ro.time, "root": ro.root, "com": ro.com, **data}, attrs)
         outer.report(TRAIN_SHARE + 0.02, "measuring the trained policy")
         ev = self.measure(spec, ro, trained, hooks, workdir)
         outer.report(1.0, "done")

@@ -1,11 +1,12 @@
-"""Training and the deterministic rollout of a policy task, shared by every one of them.
+"""Training a policy task's policy and writing what its deterministic rollout shows, shared by every one.
 
 ``train_policy`` trains PPO (``toolkit.rl.ppo.train``) on a task's environments with the ``agent``
 group's hyper-parameters, in the evaluation's folder (``ppo.h5``, so a killed evaluation resumes),
-opening the ``executor`` for ``agent.n_workers > 1`` and closing it again. ``rollout`` runs the
-trained policy's mean action once, recording what the task asks per control step and rendering
-frames; ``save_motion`` writes them as ``filmstrip.png`` (a few frames side by side) and
-``motion.gif`` (every frame); ``return_curve`` is the training curve against samples.
+opening the ``executor`` for ``agent.n_workers > 1`` and closing it again; ``agent_config`` is
+that group's ``PPOConfig`` (its ``total_samples`` is the evaluation's budget). The trained
+policy's deterministic episode is ``toolkit.policy.episodes.rollout``; ``save_motion`` writes its
+frames as ``filmstrip.png`` (a few frames side by side) and ``motion.gif`` (every frame);
+``return_curve`` is the training curve against samples.
 """
 
 from __future__ import annotations
@@ -120,48 +121,6 @@ def train_policy(env_fn: Callable[[int], Any], agent: Any, executor: Any, workdi
         if pool is not None:
             pool.close()
     return Trained(result=result, config=cfg, wall_s=time.perf_counter() - t0, checkpoint=path)
-
-
-def rollout(env: Any, model: Any, record: Callable[[Any], dict], frames: int = 0, width: int = 160,
-            height: int = 120, options: Optional[dict] = None) -> dict[str, Any]:
-    """One deterministic episode (the policy's mean action) from ``env.reset(seed=0, options)``.
-
-    Args:
-        env: the environment.
-        model: the policy (``act(obs)``).
-        record: ``record(env) -> {name: value}`` before the first step and after every step.
-        frames: render every control step when > 0 (``frames`` of them go to the filmstrip).
-        width, height: frame size (px).
-        options: the reset options (e.g. a start time).
-
-    Returns:
-        ``return``, ``info`` (the last step's), ``frames`` (every rendered frame), ``steps`` and
-        one array per recorded name, ``(n_steps + 1, ...)``.
-    """
-    from toolkit.execution import stopping
-
-    stopping.check()  # a safe point (SIGTERM): between the episodes of a final evaluation
-    obs, _ = env.reset(seed=0, options=options)
-    rows: list[dict] = []
-    imgs: list[np.ndarray] = []
-    done, ret, info, steps = False, 0.0, {}, 0
-
-    def snap() -> None:
-        rows.append(record(env))
-        if frames > 0:
-            imgs.append(env.render_frame(width, height))
-
-    snap()
-    while not done:
-        obs, r, te, tr, info = env.step(model.act(obs).astype(np.float32))
-        ret += r
-        steps += 1
-        done = te or tr
-        snap()
-    out: dict[str, Any] = {"return": ret, "info": info, "frames": imgs, "steps": steps}
-    for key in rows[0]:
-        out[key] = np.array([row[key] for row in rows])
-    return out
 
 
 def pick_frames(frames: list, n: int) -> list:

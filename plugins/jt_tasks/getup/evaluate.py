@@ -34,27 +34,24 @@ COLUMNS = ("success", "got_up", "time_to_rise", "task_return_rate", "early")  #:
 def evaluate_regions(task: Any, spec: Any, model: Any) -> dict[str, dict[str, np.ndarray]]:
     """One deterministic get-up per evaluation drop of each region: ``{region: {column: (n,)}}``
     plus ``x``, ``z``, ``style`` (0 prone, 1 supine) and ``curve`` per episode."""
-    from toolkit.policy.train import rollout
+    from toolkit.policy.episodes import opened_env, rollout
 
     p = task.params
     out: dict[str, dict[str, np.ndarray]] = {}
     for name in p.eval_regions:
         region = REGIONS.index(name)
         states = task.fallen(spec.sim, [region], p.eval_locations, p.eval_seed)
-        env = task.env_class(dataclasses.replace(spec, fallen=states), seed=0)
-        env.terrain_level = region
         rows = []
-        try:
+        with opened_env(task.env_class, dataclasses.replace(spec, fallen=states), seed=0) as env:
+            env.terrain_level = region
             for i, st in enumerate(states):
-                info = rollout(env, model, lambda e: {}, 0, 1, 1, {"kind": "fallen", "fallen": i})["info"]
+                info = rollout(env, model, options={"kind": "fallen", "fallen": i}).info
                 rows.append({"success": info.get("success", 0.0), "got_up": info.get("got_up", 0.0),
                              "time_to_rise": info.get("time_to_rise", math.nan),
                              "task_return_rate": info.get("task_return_rate", 0.0),
                              "early": float(info.get("reason", "") not in ("time limit",)),
                              "x": st["xz"][0], "z": st["xz"][1], "style": float(st["style"] == "supine"),
                              "curve": info.get("curve", math.nan)})
-        finally:
-            env.close()
         out[name] = {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else {}
     return out
 

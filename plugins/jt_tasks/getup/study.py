@@ -58,15 +58,13 @@ def open_loop_clip(clip: str, sim_groups: dict, t_stand: float = 3.0, mirrored: 
 
 
 def episode(env: Any, model: Any, options: dict) -> dict[str, Any]:
-    """One deterministic episode: steps, the end's reason, the highest neck height, got_up, success."""
-    obs, _ = env.reset(seed=0, options=options)
-    done, steps, h_max, info = False, 0, 0.0, {}
-    while not done:
-        obs, _, te, tr, info = env.step(model.act(obs).astype(np.float32))
-        steps += 1
-        done = te or tr
-        h_max = max(h_max, float(env.measure()["features"][0]))
-    return {"steps": steps, "reason": str(info.get("reason", "")), "h_max": h_max,
+    """One deterministic episode: steps, the end's reason, the highest neck height after a step
+    (0 at least), got_up, success."""
+    from toolkit.policy.episodes import rollout
+
+    ro = rollout(env, model, lambda e: {"h": float(e.measure()["features"][0])}, options=options)
+    info, h_max = ro.info, float(max([0.0, *ro.series["h"][1:]]))  # not the start's height
+    return {"steps": ro.steps, "reason": str(info.get("reason", "")), "h_max": h_max,
             "got_up": float(info.get("got_up", 0.0)), "success": float(info.get("success", 0.0))}
 
 

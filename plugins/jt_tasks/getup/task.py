@@ -24,7 +24,8 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.getup.config import GetupConfig
-from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
+from toolkit.policy.episodes import Rollout, opened_env, rollout
+from toolkit.policy.history import IterationHistory, mean_of, measured, numbers
 from toolkit.policy.task import Hooks, PolicyTask, require_character_and_prior
 
 _FALLEN: dict[tuple, list] = {}  #: fallen_states memo per process: {(groups, params): states}
@@ -148,10 +149,9 @@ class GetupTask(PolicyTask):
         import functools
 
         from jt_tasks.getup.stage1 import ClipStartTraining
-        from toolkit.policy.train import agent_config
         from toolkit import plugins
 
-        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
+        total = self.sample_budget(ctx)
         node = group_of(self.cfg, "curriculum")
         cur = plugins.load("curriculum", str(node.name))(node) if node is not None and "name" in node else None
         extra: dict[str, Any] = cur.bind({}) if cur is not None else {}
@@ -195,56 +195,50 @@ class GetupTask(PolicyTask):
         out["targets"] = np.asarray(env.targets(env.t), float)
         return out
 
-    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
-        info = ro["info"]
-        ro["log"] = list(env.log)
-        data = {"features": ro["features"], "targets": ro["targets"],
+    def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
+        info = ro.info
+        ro.notes["log"] = list(env.log)
+        data = {"features": ro.series["features"], "targets": ro.series["targets"],
                 "curve_control": np.asarray(env.curve.control), "info": numbers(info)}
         if env.log:
             data["terms"] = {k: np.array([row[k] for row in env.log]) for k in env.log[0]}
         attrs = {"curve": env.curve.name, "duration": float(env.curve.duration), "start_kind": env.start_kind,
-                 "return": float(ro["return"]), "reason": str(info.get("reason", ""))}
+                 "return": float(ro.return_), "reason": str(info.get("reason", ""))}
         return data, attrs
 
-    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Hooks, workdir: Path) -> Evaluation:
-        from toolkit.policy.train import return_curve, rollout
+    def measure(self, spec: Any, ro: Rollout, trained: Any, hooks: Hooks, workdir: Path) -> Evaluation:
         from toolkit.rl.checkpoint import load_policy
 
         from jt_tasks.getup import evaluate as E
 
-        res, info, p = trained.result, ro["info"], self.params
+        res, info, p = trained.result, ro.info, self.params
         infos = [info]
         model = load_policy(trained.checkpoint)
         if p.eval_episodes > 1:
-            env = self.env_class(spec, seed=0)
-            try:
+            with opened_env(self.env_class, spec, seed=0) as env:
                 for opts in self.eval_options(env, p.eval_episodes)[1:]:
-                    infos.append(rollout(env, model, lambda e: {}, 0, 1, 1, opts)["info"])
-            finally:
-                env.close()
+                    infos.append(rollout(env, model, options=opts).info)
         metrics = {
             "success": float(info.get("success", 0.0)), "got_up": float(info.get("got_up", 0.0)),
             "success_rate": float(np.mean([i.get("success", 0.0) for i in infos])),
             "got_up_rate": float(np.mean([i.get("got_up", 0.0) for i in infos])),
             "r_task_mean": float(info.get("r_task_mean", 0.0)),
             "task_return_rate": float(np.mean([i.get("task_return_rate", 0.0) for i in infos])),
-            "episode_time": float(info.get("episode_time", 0.0)), **base_metrics(ro, trained)}
+            "episode_time": float(info.get("episode_time", 0.0))}
         if p.eval_clip_starts > 0:  # issue 29's stage 1: perturbed clip starts, seeds never used in training
             from jt_tasks.getup.stage1 import clip_start_success
 
-            env = self.env_class(spec, seed=0)
-            try:
+            with opened_env(self.env_class, spec, seed=0) as env:
                 st1 = clip_start_success(env, model, p.eval_clip_starts, p.eval_start_noise, seed=0)
-            finally:
-                env.close()
             metrics["success_clip"], metrics["got_up_clip"] = st1["success"], st1["got_up"]
         if p.eval_regions:  # 003 §6.3, Table 1
             table = E.evaluate_regions(self, spec, model)
             figures = E.table_metrics(table)
             metrics.update(figures)
             E.write_table(workdir / "table1.h5", table, figures)
-        E.plot_curves(workdir / "curves.png", np.asarray(ro["time"], float), np.asarray(ro["features"], float),
-                      np.asarray(ro["targets"], float), f"{info.get('reason', '')}: curve {spec.curves[int(info.get('curve', 0))]['name']}")
+        E.plot_curves(workdir / "curves.png", np.asarray(ro.time, float), np.asarray(ro.series["features"], float),
+                      np.asarray(ro.series["targets"], float),
+                      f"{info.get('reason', '')}: curve {spec.curves[int(info.get('curve', 0))]['name']}")
         for k in ("r_getup_height", "r_getup_torso", "r_getup_velocity", "r_getup_pose", "r_naturalness"):
             if f"{k}_mean" in info:
                 metrics[f"{k}_mean"] = float(info[f"{k}_mean"])
@@ -255,12 +249,11 @@ class GetupTask(PolicyTask):
             level = cur.env_attrs().get("terrain_level")  # what the env reads (Curriculum.env_attrs)
             if level is not None:
                 metrics["terrain_level"] = float(level)
-        metrics = finite(metrics)
-        history = {"mean_return": return_curve(trained), **hooks.state["history"].curves(res.extra, prefix="train_")}
+        metrics, history = measured(ro, trained, metrics, hooks.state["history"].curves(res.extra, prefix="train_"))
         rows = hooks.state["training"].history() if "training" in hooks.state else np.zeros((0, 3))
         if len(rows):  # the deterministic get-ups from perturbed clip starts during training
-            history["eval_success_clip"] = [(int(r[0]), float(r[1])) for r in rows]
-            history["eval_got_up_clip"] = [(int(r[0]), float(r[2])) for r in rows]
+            history.update(hooks.state["training"].curves({"success": "eval_success_clip",
+                                                           "got_up": "eval_got_up_clip"}))
             metrics["best_success_clip_during"] = float(rows[:, 1].max())
         if hooks.state.get("window") is not None:  # the reverse curriculum's front over training
             from jt_tasks.getup.reverse import KEY, MOVES_KEY

@@ -24,6 +24,7 @@ from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
 from jt_tasks.jumping.config import JumpConfig, LongJumpConfig, ObstacleConfig
+from toolkit.policy.episodes import Rollout
 from toolkit.policy.task import PolicyTask, require_character_and_prior
 
 
@@ -190,10 +191,9 @@ class JumpTask(PolicyTask):
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def training(self, spec: Any, ctx: EvalContext) -> Any:
         from jt_tasks.jumping.train import curriculum_hooks
-        from toolkit.policy.train import agent_config
 
         init = self.stage2_init()
-        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
+        total = self.sample_budget(ctx)
         return curriculum_hooks(spec, self.curriculum(), total, ctx.progress,
                                 warm_start=init.checkpoint if init is not None else None)
 
@@ -208,7 +208,7 @@ class JumpTask(PolicyTask):
         z_min, dz = getattr(p, "z_min", None), getattr(p, "dz", None)
         self._fallback = (float(z_min), float(dz), hooks.state["z_attr"]) if z_min is not None and dz else None
 
-    def retry_rollout(self, env: Any, ro: dict) -> bool:
+    def retry_rollout(self, env: Any, ro: Rollout) -> bool:
         """``task.final_fallback``: one Δz lower when the jump never crossed the plane (not below z_min)."""
         fallback = getattr(self, "_fallback", None)
         if not self.params.final_fallback or fallback is None or math.isfinite(env.tracker.stage1()):
@@ -220,55 +220,54 @@ class JumpTask(PolicyTask):
         setattr(env, attr, z)
         return True
 
-    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
-        ro["feature_quat"] = env.tracker.stage2(env.suite.rotation())
-        ro["feature_angle"] = env.tracker.stage1()
-        ro["feature_time"] = float(env.tracker.time)
-        ro["final_z"] = float(env.difficulty)
-        data = {"feature_quat": np.asarray(ro["feature_quat"], dtype=float),
-                "feature_angle": np.array([ro["feature_angle"]])}
+    def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
+        notes = ro.notes
+        notes["feature_quat"] = env.tracker.stage2(env.suite.rotation())
+        notes["feature_angle"] = env.tracker.stage1()
+        notes["feature_time"] = float(env.tracker.time)
+        notes["final_z"] = float(env.difficulty)
+        data = {"feature_quat": np.asarray(notes["feature_quat"], dtype=float),
+                "feature_angle": np.array([notes["feature_angle"]])}
         attrs = {"features": {k: float(v) for k, v in spec.features.items()}, "kind": spec.kind,
-                 "return": float(ro["return"]), "reason": str(ro["info"].get("reason", ""))}
+                 "return": float(ro.return_), "reason": str(ro.info.get("reason", ""))}
         return data, attrs
 
-    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
+    def measure(self, spec: Any, ro: Rollout, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
         from jt_tasks.jumping.train import jump_curves
-        from toolkit.policy.history import base_metrics, finite
-        from toolkit.policy.train import return_curve
+        from toolkit.policy.history import finite, measured
 
-        res, init = trained.result, self.stage2_init()
+        res, init, notes = trained.result, self.stage2_init(), ro.notes
         trained_z = float(hooks.state["cur"].env_attrs().get(hooks.state["z_attr"], math.nan))  # the curriculum's z
         succ = [r for _, _, r in hooks.state["z_hist"] if math.isfinite(r)]
-        angle = float(ro["feature_angle"])
-        metrics = {
-            "strategy_angle": angle, "bar_height_reached": float(ro.get("final_z", trained_z)),
-            "bar_height_trained": trained_z, **base_metrics(ro, trained),
-            "success_rate": succ[-1] if succ else 0.0, "final_success": float(ro["info"].get("success", 0.0))}
-        metrics.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
-        metrics.update({f"feature_q{i}": float(v) for i, v in enumerate(ro["feature_quat"])})
+        angle = float(notes["feature_angle"])
+        own = {"strategy_angle": angle, "bar_height_reached": float(notes.get("final_z", trained_z)),
+               "bar_height_trained": trained_z, "success_rate": succ[-1] if succ else 0.0,
+               "final_success": float(ro.info.get("success", 0.0))}
+        own.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
+        own.update({f"feature_q{i}": float(v) for i, v in enumerate(notes["feature_quat"])})
         if init is not None:
             from jt_tasks.jumping.stage2 import novelty_metrics
 
-            metrics.update(novelty_metrics(ro["feature_quat"], spec.policy_features, spec.reward_terms))
-            metrics["init_eval_index"] = float(init.eval_index)
-        history = {"mean_return": return_curve(trained), **jump_curves(hooks, res)}
+            own.update(novelty_metrics(notes["feature_quat"], spec.policy_features, spec.reward_terms))
+            own["init_eval_index"] = float(init.eval_index)
+        metrics, history = measured(ro, trained, own, jump_curves(hooks, res), keep_nonfinite=True)
         self._write_peak(ro, workdir)
         if not math.isfinite(angle):
             return Evaluation(metrics=finite(metrics), failed=True,
                               reason="the deterministic jump never crossed the bar plane", history=history)
         return Evaluation(metrics=metrics, features=[angle], history=history)
 
-    def _write_peak(self, ro: dict, workdir: Path) -> None:
+    def _write_peak(self, ro: Rollout, workdir: Path) -> None:
         """``peak.png``: the rendered control step nearest the CoM's crossing of the bar plane
         (the strategy gallery's picture, ``000`` Fig. 7); nothing when it never crossed."""
         from jt_tasks.jumping.gallery import PEAK
 
-        t, frames = float(ro.get("feature_time", math.nan)), ro.get("frames") or []
+        t, frames = float(ro.notes.get("feature_time", math.nan)), ro.frames
         if not math.isfinite(t) or not frames:
             return
         import imageio.v3 as iio
 
-        i = int(np.argmin(np.abs(np.asarray(ro["time"], dtype=float)[: len(frames)] - t)))
+        i = int(np.argmin(np.abs(np.asarray(ro.time, dtype=float)[: len(frames)] - t)))
         iio.imwrite(Path(workdir) / PEAK, np.asarray(frames[i])[..., :3].astype(np.uint8))
 
     def extra_artifacts(self, workdir: Path) -> list[str]:

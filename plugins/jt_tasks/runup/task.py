@@ -18,11 +18,11 @@ from typing import Any, ClassVar, Optional
 
 import numpy as np
 
-from toolkit.config import group_of
 from toolkit.interfaces.searcher import Param, SearchProblem, Space
 from toolkit.interfaces.task import EvalContext, Evaluation
 
-from toolkit.policy.history import IterationHistory, base_metrics, finite, numbers
+from toolkit.policy.episodes import Rollout
+from toolkit.policy.history import IterationHistory, measured, numbers
 from toolkit.policy.task import Hooks, PolicyTask, require_character_and_prior
 
 from jt_tasks.runup.config import RunupConfig
@@ -97,11 +97,9 @@ class RunupTask(PolicyTask):
     def training(self, spec: Any, ctx: EvalContext) -> Any:
         """The per-iteration means of finished episodes' ``r_goal``, imitation reward and take-off
         rate (``extra["goal_history"]``)."""
-        from toolkit.policy.train import agent_config
-
         extra: dict[str, Any] = {}
-        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
-        hist = IterationHistory(extra, "goal_history", HISTORY, total, ctx.progress, shown=("r_goal", ".3f"))
+        hist = IterationHistory(extra, "goal_history", HISTORY, self.sample_budget(ctx), ctx.progress,
+                                shown=("r_goal", ".3f"))
         return Hooks(on_iteration=hist.on_iteration, extra=extra, state={"history": hist})
 
     def final_options(self, env: Any) -> Optional[dict]:
@@ -115,33 +113,31 @@ class RunupTask(PolicyTask):
         out["ref_root"] = env.ref.at(env.j0 + env.substeps_done).q[:7].copy()
         return out
 
-    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
-        info = ro["info"]
-        ro["q"], ro["qd"] = env.sim.state()
-        ro["targets"] = dict(env.targets)
-        ro["phase_time"] = float(env.ref.phase(env.clip_time) * env.ref.period)
-        data = {"ref_root": ro["ref_root"], "r_imitation": np.array([t["imitation"] for t in env.terms_log]),
+    def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
+        info, notes = ro.info, ro.notes
+        notes["q"], notes["qd"] = env.sim.state()
+        notes["targets"] = dict(env.targets)
+        notes["phase_time"] = float(env.ref.phase(env.clip_time) * env.ref.period)
+        data = {"ref_root": ro.series["ref_root"], "r_imitation": np.array([t["imitation"] for t in env.terms_log]),
                 "info": numbers(info)}
-        attrs = {"kind": spec.kind, "targets": str(ro["targets"]), "return": float(ro["return"]),
+        attrs = {"kind": spec.kind, "targets": str(notes["targets"]), "return": float(ro.return_),
                  "reason": str(info.get("reason", ""))}
         return data, attrs
 
-    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
-        from toolkit.policy.train import return_curve
+    def measure(self, spec: Any, ro: Rollout, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
         from jt_tasks.takeoff.state_file import NAME, write_takeoff_state
 
-        info = ro["info"]
+        info, notes = ro.info, ro.notes
         if info.get("took_off"):
             achieved = {k[len("takeoff_"):]: float(v) for k, v in info.items() if k.startswith("takeoff_")}
-            write_takeoff_state(workdir / NAME, ro["q"], ro["qd"], achieved, ro["targets"], spec.foot, spec.kind,
-                                ro["phase_time"], float(info["r_goal"]))
-        base = base_metrics(ro, trained)  # the summary line shows the first few: the task's own first
-        metrics = {"goal_reward": float(info.get("r_goal", 0.0)), "imitation_reward": float(info.get("r_imitation_mean", 0.0)),
-                   "mean_return": base.pop("mean_return"), "train_mean_return": base.pop("train_mean_return"),
-                   "took_off": float(info.get("took_off", 0.0)), "episode_time": float(info.get("episode_time", 0.0)), **base}
-        metrics.update({f"imitation_{k}": float(info.get(f"r_{k}_mean", 0.0)) for k in ("pose", "vel", "ee", "com")})
-        metrics = finite({**metrics, **{k: v for k, v in info.items() if k.startswith(("takeoff_", "target_"))}})
-        history = {"mean_return": return_curve(trained), **hooks.state["history"].curves(trained.result.extra, CURVES)}
+            write_takeoff_state(workdir / NAME, notes["q"], notes["qd"], achieved, notes["targets"], spec.foot,
+                                spec.kind, notes["phase_time"], float(info["r_goal"]))
+        own = {"goal_reward": float(info.get("r_goal", 0.0)),
+               "imitation_reward": float(info.get("r_imitation_mean", 0.0)),
+               "took_off": float(info.get("took_off", 0.0)), "episode_time": float(info.get("episode_time", 0.0))}
+        own.update({f"imitation_{k}": float(info.get(f"r_{k}_mean", 0.0)) for k in ("pose", "vel", "ee", "com")})
+        own.update({k: v for k, v in info.items() if k.startswith(("takeoff_", "target_"))})
+        metrics, history = measured(ro, trained, own, hooks.state["history"].curves(trained.result.extra, CURVES))
         if not info.get("took_off"):
             return Evaluation(metrics=metrics, failed=True, history=history,
                               reason=f"the deterministic run-up ended before the take-off: {info.get('reason', '')}")

@@ -19,21 +19,21 @@ from typing import Any, Optional, Sequence
 from toolkit.errors import JtError, one_line_errors
 
 
-def replay(config: Any, checkpoint: str) -> tuple[Any, dict[str, Any]]:
+def replay(config: Any, checkpoint: str) -> tuple[Any, Any]:
     """The final evaluation of a run with ``config`` (its composed config) and policy
     ``checkpoint`` (``ppo.h5``), replayed: the env (still open, holding ``eval_bodies``) and the
-    rollout (``tr.rollout``'s dict)."""
-    from toolkit.policy import train as tr
+    rollout (a ``toolkit.policy.episodes.Rollout``)."""
+    from toolkit.policy.episodes import rollout
     from toolkit import plugins
     from toolkit.rl.checkpoint import load_policy
 
     task = plugins.load("task", "spacetime")(config)
     env = task.env_class(task.env_spec({}), seed=0)
-    ro = tr.rollout(env, load_policy(checkpoint), task.record, 0, 160, 120, task.final_options(env))
+    ro = rollout(env, load_policy(checkpoint), task.record, 0, 160, 120, task.final_options(env))
     return env, ro
 
 
-def windows(env: Any, ro: dict[str, Any], seconds: Sequence[Optional[float]]) -> list[dict[str, float]]:
+def windows(env: Any, ro: Any, seconds: Sequence[Optional[float]]) -> list[dict[str, float]]:
     """Per window (``None``: the whole evaluation): ``seconds``, ``steps`` (control steps measured),
     ``volume`` / ``ref_volume`` (m³), ``energy`` / ``ref_energy`` (J)."""
     from jt_tasks.spacetime.artifacts import reference_bodies, style_measures
@@ -43,7 +43,7 @@ def windows(env: Any, ro: dict[str, Any], seconds: Sequence[Optional[float]]) ->
     for w in seconds:
         n = len(bodies) if w is None else min(len(bodies), int(round(float(w) * hz)) + 1)
         pol = style_measures(bodies[:n], env.masses, hz)
-        ref = style_measures(reference_bodies(env, ro["time"][:n]), env.masses, hz)
+        ref = style_measures(reference_bodies(env, ro.time[:n]), env.masses, hz)
         rows.append({"seconds": float("nan") if w is None else float(w), "steps": float(n),
                      "volume": pol["volume"], "ref_volume": ref["volume"],
                      "energy": pol["energy"], "ref_energy": ref["energy"]})
@@ -71,7 +71,7 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
         env, ro = replay(OmegaConf.load(art / "config.yaml"), str(art / "ppo.h5"))
         try:
             for row in windows(env, ro, [*seconds, None]):
-                out.append({"run": rid, "survival_s": float(ro["info"]["survival_s"]), **row})
+                out.append({"run": rid, "survival_s": float(ro.info["survival_s"]), **row})
         finally:
             env.close()
     return out

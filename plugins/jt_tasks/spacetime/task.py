@@ -22,10 +22,10 @@ from typing import Any, ClassVar, Optional
 
 import numpy as np
 
-from toolkit.config import group_of
 from toolkit.interfaces.task import Evaluation
 
-from toolkit.policy.history import base_metrics, finite, numbers
+from toolkit.policy.episodes import Rollout
+from toolkit.policy.history import measured, numbers
 from toolkit.policy.task import Hooks, PolicyTask
 from jt_tasks.spacetime import clips
 from jt_tasks.spacetime.config import SpacetimeConfig
@@ -91,71 +91,64 @@ class SpacetimeTask(PolicyTask):
         Table 1's evaluation every ``eval_every`` iterations; their state rides in ``extra``."""
         import functools
 
-        from toolkit.policy.train import agent_config
         from jt_tasks.spacetime.sampling import StartSampler
         from jt_tasks.spacetime.training import SpacetimeTraining
 
         params = self.params.sampling_params()
         extra: dict[str, Any] = {}
         sampler = StartSampler(params, extra, ctx.seed) if (params.importance_sampling or params.evolution) else None
-        total = agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples
         hook = SpacetimeTraining(sampler, functools.partial(self.env_class, spec, seed=ctx.seed),
-                                 self.final_options(None), int(self.params.eval_every), extra, ctx.progress, total,
-                                 int(self.params.eval_starts))
+                                 self.final_options(None), int(self.params.eval_every), extra, ctx.progress,
+                                 self.sample_budget(ctx), int(self.params.eval_starts))
         return Hooks(on_iteration=hook, extra=extra, state={"sampler": sampler, "training": hook})
 
     # ------------------------------------------------------------------ evaluation (PolicyTask hooks)
     def final_options(self, env: Any) -> Optional[dict]:
         return {"phase": float(self.params.eval_phase), "evaluate": True}
 
-    def rollout_data(self, ro: dict, env: Any, spec: Any) -> tuple[dict, dict]:
+    def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
         from jt_tasks.spacetime.artifacts import com_height_data
 
         from jt_tasks.spacetime.artifacts import reference_bodies, style_measures
 
-        info = ro["info"]
-        ro["com_height"] = com_height_data(env, ro["time"], ro["com"])
-        ro["style"] = {"policy": style_measures(env.eval_bodies, env.masses, env.control_hz),  # 002 §3.3
-                       "reference": style_measures(reference_bodies(env, ro["time"]), env.masses, env.control_hz)}
-        if ro["frames"]:  # the reference at the same clip times, for motion_vs_reference.gif
+        info, notes = ro.info, ro.notes
+        notes["com_height"] = com_height_data(env, ro.time, ro.com)
+        notes["style"] = {"policy": style_measures(env.eval_bodies, env.masses, env.control_hz),  # 002 §3.3
+                          "reference": style_measures(reference_bodies(env, ro.time), env.masses, env.control_hz)}
+        if ro.frames:  # the reference at the same clip times, for motion_vs_reference.gif
             from jt_tasks.spacetime.artifacts import reference_frames
 
-            h, w = np.asarray(ro["frames"][0]).shape[:2]
-            ro["reference_frames"] = reference_frames(env, ro["time"], w, h)
-            ro["fps"] = float(env.control_hz)
-        data = {"info": numbers(info), "phase": ro["com_height"]["phase"]}
-        attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro["return"]),
+            h, w = np.asarray(ro.frames[0]).shape[:2]
+            notes["reference_frames"] = reference_frames(env, ro.time, w, h)
+            notes["fps"] = float(env.control_hz)
+        data = {"info": numbers(info), "phase": notes["com_height"]["phase"]}
+        attrs = {"clip": spec.clip, "termination": spec.termination, "return": float(ro.return_),
                  "reason": str(info.get("reason", "")), "widths": str(list(spec.widths)),
-                 **{f"{who}_{k}": v for who, m in ro["style"].items() for k, v in m.items()}}
+                 **{f"{who}_{k}": v for who, m in notes["style"].items() for k, v in m.items()}}
         return data, attrs
 
-    def measure(self, spec: Any, ro: dict, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
-        from toolkit.policy.train import last_finite, return_curve, samples_axis
+    def measure(self, spec: Any, ro: Rollout, trained: Any, hooks: Any, workdir: Path) -> Evaluation:
+        from toolkit.policy.train import last_finite, samples_axis
 
-        res, info = trained.result, ro["info"]
-        steps = int(ro["steps"])
+        res, info, notes = trained.result, ro.info, ro.notes
         survival = float(info["survival_s"])  # every evaluation episode ends with it
         lengths = res.history.get("mean_length", [])
-        metrics = {
-            "survival_s": survival,
-            "survival_steps": float(steps),
-            "survived": float(bool(info.get("time_out", 0.0))),
-            **base_metrics(ro, trained), "train_mean_length": last_finite(lengths)}
-        for who, m in ro.get("style", {}).items():  # style measures vs the reference's (002 §3.3, §5.3)
+        own = {"survival_s": survival, "survival_steps": float(ro.steps),
+               "survived": float(bool(info.get("time_out", 0.0))), "train_mean_length": last_finite(lengths)}
+        for who, m in notes.get("style", {}).items():  # style measures vs the reference's (002 §3.3, §5.3)
             prefix = "style" if who == "policy" else "ref"
-            metrics.update({f"{prefix}_energy": m["energy"], f"{prefix}_volume": m["volume"]})
-        metrics = finite(metrics)
-        history = {"mean_return": return_curve(trained),
-                   "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]}
-        if "com_height" in ro:
+            own.update({f"{prefix}_energy": m["energy"], f"{prefix}_volume": m["volume"]})
+        metrics, history = measured(ro, trained, own, {
+            "mean_length": [(s, float(v)) for s, v in zip(samples_axis(trained), lengths) if math.isfinite(v)]})
+        if "com_height" in notes:
             from jt_tasks.spacetime.artifacts import plot_com_bounds
 
-            plot_com_bounds(ro["com_height"], Path(workdir) / "com_bounds.png",
+            plot_com_bounds(notes["com_height"], Path(workdir) / "com_bounds.png",
                             f"{Path(str(spec.clip)).stem}: CoM height vs phase, final rollout (002 Fig. 5)")
-        if ro.get("reference_frames"):
+        if notes.get("reference_frames"):
             from jt_tasks.spacetime.artifacts import write_motion_vs_reference
 
-            write_motion_vs_reference(workdir, ro["frames"], ro["reference_frames"], ro["fps"])
+            write_motion_vs_reference(workdir, ro.frames, notes["reference_frames"], notes["fps"])
         hook = hooks.state.get("training")
         if hook is not None and hook.n_starts > 1:  # the final policy from every start phase
             mean, share, worst = hook.evaluate(trained.result.model)
@@ -165,8 +158,7 @@ class SpacetimeTask(PolicyTask):
         if len(rows):
             from jt_tasks.spacetime.training import samples_to_20s
 
-            history["survival_s"] = [(int(r[0]), float(r[1])) for r in rows]
-            history["survival_min_s"] = [(int(r[0]), float(r[3])) for r in rows]
+            history.update(hook.curves({"survival_s": "survival_s", "survival_min_s": "survival_min_s"}))
             reached = samples_to_20s(rows)
             if reached is not None:
                 metrics["samples_to_20s"] = reached

@@ -7,7 +7,8 @@
   phases spread evenly from ``eval_phase`` (the authors average several episodes from random
   phases) with bounds off, up to ``eval_time_limit`` (20 s), failing only on a forbidden ground
   contact (the final rollout's set-up); ``(samples, mean survival_s, share survived, min
-  survival_s)`` rows go to ``extra["eval_history"]`` (checkpointed, so a resumed run keeps them).
+  survival_s)`` rows go to ``extra["eval_history"]`` (checkpointed, so a resumed run keeps them:
+  ``toolkit.policy.periodic.PeriodicEvaluation``).
   ``samples_to_20s`` is the first sample count at which every start reached the time limit (the
   mean is 20 s: 002 Table 1's N_s).
 """
@@ -18,13 +19,16 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from toolkit.execution import stopping
+from toolkit.policy.episodes import opened_env, rollout
+from toolkit.policy.periodic import PeriodicEvaluation
 
-EVAL_KEY = "eval_history"
+COLUMNS = ("survival_s", "survived", "survival_min_s")  #: an evaluation's row, after its samples
 
 
-class SpacetimeTraining:
-    """PPO's ``on_iteration`` of ``task=spacetime``.
+class SpacetimeTraining(PeriodicEvaluation):
+    """PPO's ``on_iteration`` of ``task=spacetime``: the start sampler's update every iteration,
+    Table 1's evaluation every ``eval_every`` (rows ``(samples, mean survival_s, share survived,
+    min survival_s)``, ``history()`` ``(n_evaluations, 4)``).
 
     Args:
         sampler: the ``StartSampler`` (None: uniform starts, nothing sent).
@@ -40,18 +44,9 @@ class SpacetimeTraining:
                  progress: Optional[Callable] = None, total: int = 1, n_starts: int = 1) -> None:
         self.sampler, self.make_env, self.options = sampler, make_env, dict(options)
         self.n_starts = max(int(n_starts), 1)
-        self.eval_every, self.extra, self.progress, self.total = int(eval_every), extra, progress, max(int(total), 1)
-        self.extra.setdefault(EVAL_KEY, np.zeros((0, 4)))
-
-    def __call__(self, iteration: int, samples: int, stats: Any) -> dict[str, Any]:
-        out = self.sampler.update(iteration, samples, stats) if self.sampler is not None else {}
-        model = getattr(stats, "model", None)
-        if self.eval_every > 0 and model is not None and iteration % self.eval_every == 0:
-            survival, survived, worst = self.evaluate(model)
-            self.extra[EVAL_KEY] = np.vstack([self.history(), [float(samples), survival, survived, worst]])
-            if self.progress is not None:
-                self.progress(min(samples / self.total, 1.0), f"survival {survival:.2f} s (min {worst:.2f})")
-        return out
+        super().__init__(extra, COLUMNS, eval_every, then=sampler.update if sampler is not None else None,
+                         progress=progress, total=total,
+                         message=lambda v: f"survival {v[0]:.2f} s (min {v[2]:.2f})")
 
     def phases(self) -> list[float]:
         """The evaluation's start phases ``eval_phase + k / n_starts`` (mod 1)."""
@@ -61,28 +56,14 @@ class SpacetimeTraining:
     def evaluate(self, model: Any) -> tuple[float, float, float]:
         """``(mean survival_s, share survived, min survival_s)`` of the deterministic policy from
         each of ``phases()``."""
-        env = self.make_env()
         out = []
-        try:
+        with opened_env(self.make_env) as env:
             for phase in self.phases():
-                stopping.check()  # a safe point (SIGTERM): between the evaluation's episodes
-                obs, _ = env.reset(seed=0, options={**self.options, "phase": phase})
-                info: dict = {}
-                done, steps = False, 0
-                while not done:
-                    obs, _, te, tr, info = env.step(model.act(obs).astype(np.float32))
-                    steps += 1
-                    done = te or tr
-                out.append((float(info.get("survival_s", steps / env.control_hz)),
-                            float(bool(info.get("time_out", 0.0)))))
-        finally:
-            env.close()
+                ro = rollout(env, model, options={**self.options, "phase": phase})
+                out.append((float(ro.info.get("survival_s", ro.steps / env.control_hz)),
+                            float(bool(ro.info.get("time_out", 0.0)))))
         s = np.array(out)
         return float(s[:, 0].mean()), float(s[:, 1].mean()), float(s[:, 0].min())
-
-    def history(self) -> np.ndarray:
-        """Rows ``(samples, mean survival_s, share survived, min survival_s)`` ``(n_evaluations, 4)``."""
-        return np.asarray(self.extra.get(EVAL_KEY, np.zeros((0, 4))), dtype=float).reshape(-1, 4)
 
 
 def samples_to_20s(rows: np.ndarray) -> Optional[float]:

@@ -7,7 +7,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, numbers
+from toolkit.policy.episodes import Rollout
+from toolkit.policy.history import IterationHistory, base_metrics, finite, mean_of, measured, numbers
 
 
 def stats(*episodes: dict) -> SimpleNamespace:
@@ -57,6 +58,25 @@ def test_metric_plumbing():
     assert numbers({"x": 1, "y": 2.5, "reason": "fell", "ok": True}) == {"x": 1.0, "y": 2.5, "ok": 1.0}
     assert finite({"a": 1.0, "b": math.nan, "c": math.inf}) == {"a": 1.0}
     res = SimpleNamespace(history={"mean_return": [1.0, 2.0, math.nan]}, samples=4096, iterations=2)
-    m = base_metrics({"return": 3.5}, SimpleNamespace(result=res, samples_per_s=100.0, wall_s=41.0))
+    m = base_metrics(Rollout(return_=3.5, info={}, steps=7),
+                     SimpleNamespace(result=res, samples_per_s=100.0, wall_s=41.0))
     assert m == {"mean_return": 3.5, "train_mean_return": 2.0, "samples": 4096.0, "iterations": 2.0,
                  "samples_per_s": 100.0, "train_wall_s": 41.0}
+
+
+def test_measured_puts_the_task_metrics_first_drops_nonfinite_and_leads_the_curves_with_the_return():
+    from toolkit.policy.train import TIMES
+
+    res = SimpleNamespace(history={"mean_return": [1.0, math.nan, 3.0]}, samples=96, iterations=3,
+                          extra={TIMES: [10.0, 11.0, 12.0]})
+    cfg = SimpleNamespace(n_workers=1, envs_per_worker=2, samples_per_iteration=31)  # 32 per iteration
+    trained = SimpleNamespace(result=res, config=cfg, samples_per_s=math.nan, wall_s=5.0)
+    ro = Rollout(return_=2.5, info={}, steps=4)
+    metrics, history = measured(ro, trained, {"height": 1.5, "angle": math.nan}, {"own": [(32, 0.1)]})
+    assert list(metrics) == ["height", "mean_return", "train_mean_return", "samples", "iterations",
+                             "train_wall_s"]  # nan angle and samples_per_s left out
+    assert metrics["mean_return"] == 2.5 and metrics["train_mean_return"] == 3.0
+    assert list(history) == ["mean_return", "own"]
+    assert history["mean_return"] == [(32, 1.0, 10.0), (96, 3.0, 12.0)]  # iterations without an episode left out
+    kept, _ = measured(ro, trained, {"angle": math.nan}, keep_nonfinite=True)
+    assert math.isnan(kept["angle"]) and math.isnan(kept["samples_per_s"])

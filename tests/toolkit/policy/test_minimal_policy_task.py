@@ -36,6 +36,19 @@ def test_the_documented_task_trains_and_writes_its_artifacts(stand_cfg, tmp_path
     assert set(ev.artifacts) == {"ppo.h5", "rollout.h5", "filmstrip.png", "motion.gif"}
 
 
+def test_the_sample_budget_is_the_agent_groups_total_samples(stand_cfg, tmp_path):
+    from stand_example import StandTask
+
+    from toolkit.interfaces import EvalContext
+    from toolkit.policy.train import agent_config
+
+    ctx = EvalContext(index=0, seed=5, workdir=tmp_path)
+    want = agent_config(stand_cfg.agent, 5).total_samples
+    assert StandTask(stand_cfg).sample_budget(ctx) == want
+    stand_cfg.agent.total_samples = want + 64
+    assert StandTask(stand_cfg).sample_budget(ctx) == want + 64
+
+
 def test_the_documented_env_passes_the_gymnasium_checker(stand_cfg):
     from gymnasium.utils.env_checker import check_env
     from stand_example import StandTask

@@ -89,7 +89,7 @@ def test_every_user_value_reaches_the_spacetime_spec():
     from jt_tasks.spacetime.config import SpacetimeConfig
     from jt_tasks.spacetime.env import SpacetimeSpec
 
-    values = {"clip": "walk", "loop": False, "ground_clearance": 0.002, "cycle_turn": False, "straighten": True,
+    values = {"clip": "walk", "loop": True, "ground_clearance": 0.002, "cycle_turn": False, "straighten": True,
               "root_orientation": "heading", "velocities": "links", "ffc_lead": 1.0, "ffc_velocity": True, "termination": "contact",
               "time_limit": 5.0, "hold_s": 0.25, "init_phase": 0.5, "eval_time_limit": 3.0, "mix": 0.5,
               "style": [{"name": "energy"}], "heading_axis": "z"}

@@ -18,7 +18,7 @@ def test_replay_reproduces_the_logged_style_measures_and_windows_are_prefixes(tm
     env, ro = style_study.replay(cfg, str(tmp_path / "ppo.h5"))
     try:
         first = ev.metrics.get("survival_first_s", ev.metrics["survival_s"])  # the final rollout (eval_phase)
-        assert float(ro["info"]["survival_s"]) == pytest.approx(first, abs=1e-12)
+        assert float(ro.info["survival_s"]) == pytest.approx(first, abs=1e-12)
         short, whole = style_study.windows(env, ro, [0.2, None])
     finally:
         env.close()
