@@ -265,7 +265,6 @@ class PolicyTask(Task):
         """With ``task.evaluate``: copy its checkpoint into ``workdir`` (where training resumes from)
         and return the ``PPOConfig`` change that makes its sample count the budget, so PPO resumes
         with nothing left to collect; None without it."""
-        import os
         import shutil
 
         from toolkit.rl.checkpoint import load, with_architecture
@@ -275,9 +274,10 @@ class PolicyTask(Task):
             return None
         dst = Path(workdir) / tr.CHECKPOINT
         if not dst.exists():  # copied whole, then renamed: a kill never leaves half a checkpoint
-            tmp = dst.with_name(f"{dst.name}.tmp-{os.getpid()}")
-            shutil.copyfile(src, tmp)
-            os.replace(tmp, dst)
+            from toolkit.store.atomic import atomic_write
+
+            with atomic_write(dst) as tmp:
+                shutil.copyfile(src, tmp)
         done = int(load(dst)[0]["counters"]["samples"])
         return lambda c: dataclasses.replace(with_architecture(c, dst), total_samples=done)
 

@@ -13,7 +13,6 @@ not terminated early, from a fallen start (clip or rag-doll), whose neck height 
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
@@ -51,6 +50,8 @@ class GetupTask(PolicyTask):
     #: one deterministic episode, no periodic evaluation, no Table 1 evaluation (a benchmark's)
     cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0", "eval_episodes": "1",
                                                   "eval_every": str(10 ** 9), "eval_regions": "[]"}
+    #: ``jt study getup TOOL``: the analysis tools (``jt_tasks.getup.analysis``)
+    studies: ClassVar[dict[str, str]] = {"policy": "jt_tasks.getup.analysis.study:main"}
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:
@@ -115,9 +116,9 @@ class GetupTask(PolicyTask):
                                              p.ragdoll_kd, p.settle_max, p.rest_speed,
                                              terrain=dict(p.terrain or {}) or None, region=region, sim_hz=p.drop_hz)
                 if cache is not None:  # written whole, then renamed: a kill never leaves half a file
-                    tmp = cache.with_name(f"{cache.name}.tmp-{os.getpid()}")  # the store's temp-file pattern
-                    tmp.write_text(json.dumps(_FALLEN[key]))
-                    tmp.replace(cache)
+                    from toolkit.store.atomic import write_text
+
+                    write_text(cache, json.dumps(_FALLEN[key]))
             out.extend(_FALLEN[key])
         return out
 
