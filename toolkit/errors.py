@@ -27,7 +27,7 @@ class BrokenPlugin(JtError):
 
 
 def one_line_errors(main: "Callable[..., Any]") -> "Callable[..., Any]":
-    """Decorate a ``python -m`` tool's ``main``: a ``JtError`` is printed as one line on stderr
+    """Decorate a tool's ``main`` (``jt study``, ``python -m``): a ``JtError`` is printed as one line on stderr
     (``jt: ...``) and the tool exits with status 2, as the ``jt`` command does."""
     import functools
 

@@ -6,13 +6,17 @@ tables: the registry finds them, so the core names no task. ``jt study`` lists e
 ``jt study TASK`` one task's, ``jt study TASK TOOL --help`` a tool's arguments.
 
 A tool builds its parser with ``parser(...)``: a mistake in its arguments is one ``JtError`` line
-(``jt: <tool>: <what>``, exit 2), as everywhere in jt, instead of argparse's usage block.
+(``jt: <tool>: <what>``, exit 2), as everywhere in jt, instead of argparse's usage block. Before any
+work it checks its inputs with ``existing_file``, ``writable_file`` / ``writable_folder`` and
+``task_of`` (the task of the run that wrote a file), each failure one ``JtError`` line too.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import tempfile
+from pathlib import Path
 from typing import Any, Callable, Optional, Sequence
 
 from toolkit.errors import JtError
@@ -33,6 +37,82 @@ def parser(prog: str, description: str) -> argparse.ArgumentParser:
         description: the tool's one-paragraph help.
     """
     return _OneLineParser(prog=prog, description=description)
+
+
+def existing_file(path: Any, what: str) -> Path:
+    """``path`` as a ``Path`` when it is a file; else one ``JtError`` line (``<what> <path>: no such
+    file``, or ``... is a folder``)."""
+    p = Path(path).expanduser()
+    if p.is_dir():
+        raise JtError(f"{what} {path}: is a folder, not a file")
+    if not p.is_file():
+        raise JtError(f"{what} {path}: no such file")
+    return p
+
+
+def writable_file(path: Any, option: str, suffix: Optional[str] = None) -> Path:
+    """``path`` as a ``Path`` when a file can be written there (its folder is created as writing
+    would create it; a file made for the check is removed again); else one ``JtError`` line naming
+    ``option``. ``suffix`` (``".png"``): the file must end so."""
+    p = Path(path).expanduser()
+    if suffix is not None and p.suffix.lower() != suffix:
+        raise JtError(f"{option}={path}: the output is a {suffix} file (e.g. {option} out{suffix})")
+    existed = p.exists()
+    try:
+        if p.is_dir():
+            raise IsADirectoryError(21, "is a folder")
+        p.parent.mkdir(parents=True, exist_ok=True)
+        with open(p, "a"):
+            pass
+    except OSError as e:
+        raise JtError(f"{option}={path}: cannot write there ({e.strerror or e}); give another path") from None
+    if not existed:
+        p.unlink()
+    return p
+
+
+def writable_folder(path: Any, option: str) -> Path:
+    """``path`` as a ``Path`` when files can be written in it (created if missing, as writing
+    would); else one ``JtError`` line naming ``option``."""
+    p = Path(path).expanduser()
+    try:
+        if p.exists() and not p.is_dir():
+            raise NotADirectoryError(20, "is a file, not a folder")
+        p.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=p):
+            pass
+    except OSError as e:
+        raise JtError(f"{option}={path}: cannot write there ({e.strerror or e}); give another folder") from None
+    return p
+
+
+def task_of(found: Any) -> Optional[str]:
+    """The task of the run that wrote an artifact, or None when nothing says: ``found`` is a
+    ``toolkit.store.resolve.Resolved`` (its run's ``jt.task`` tag) or a path; else the
+    ``config.yaml`` beside the file or in the folder above (a run's work folder holds one)."""
+    run = getattr(found, "run", None)
+    tag = run.data.tags.get("jt.task") if run is not None else None
+    if tag:
+        return str(tag)
+    path = Path(getattr(found, "path", found))
+    for folder in path.parents[:2]:
+        if (folder / "config.yaml").is_file():
+            try:
+                from omegaconf import OmegaConf
+
+                name = OmegaConf.select(OmegaConf.load(folder / "config.yaml"), "task.name")
+            except Exception:  # noqa: BLE001 - an unreadable config says nothing about the task
+                return None
+            return None if name is None else str(name)
+    return None
+
+
+def require_task(found: Any, ref: str, task: str, prog: str) -> None:
+    """One ``JtError`` line when the run that wrote ``found`` is known to be of another task than
+    ``task`` (``task_of``); nothing when it is ``task`` or unknown."""
+    other = task_of(found)
+    if other is not None and other != task:
+        raise JtError(f"{ref}: a task={other} run; {prog} reads task={task} runs")
 
 
 def studies() -> dict[str, dict[str, str]]:

@@ -5,7 +5,7 @@ spacetime motion from several start phases, the share of get-ups from perturbed 
 evaluates the learner's model (``IterationStats.model``) every ``every`` iterations and keeps one
 row per evaluation, ``(samples, *values)``, in PPO's ``extra`` under ``key``
 (``"eval_history"`` by default). ``extra`` is checkpointed in ``ppo.h5``, so a resumed run
-continues the rows where it stopped, and the study scripts read them back as
+continues the rows where it stopped, and the ``jt study`` tools read them back as
 ``extra/eval_history``. Each evaluation also draws the progress line (the share of the sample
 budget done and the task's message).
 

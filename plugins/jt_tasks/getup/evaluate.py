@@ -154,35 +154,3 @@ def longest_run(mask: np.ndarray) -> int:
         best = max(best, cur)
     return best
 
-
-def open_loop_noise(env: Any, sigma: float, steps: int, seed: int = 0) -> dict[str, float]:
-    """The action filter without learning (issue check 3): Gaussian actions of std ``sigma`` about 0
-    (the initial policy's mean and std) for ``steps`` control steps from the facedown clip's pose
-    (restarted when an episode ends). Returns the mean r_natural (eq 3) and the mean per-step change
-    of the PD targets (rad per DoF per control step)."""
-    rng = np.random.default_rng(int(seed))
-    space = env.action_space_
-    targets = space.targets
-    seen: list[np.ndarray] = []
-
-    def recording(action: np.ndarray, *a: Any, **kw: Any) -> np.ndarray:
-        seen.append(np.asarray(targets(action, *a, **kw), dtype=np.float64))
-        return seen[-1]
-
-    space.targets = recording  # read the targets each step computes, nothing else changes
-    nat, change = [], []
-    try:
-        env.reset(seed=0, options={"kind": "clip", "curve": "facedown"})
-        low, high = env.action_space.low, env.action_space.high
-        for _ in range(int(steps)):
-            before = len(seen)
-            a = np.clip(rng.normal(0.0, sigma, env.action_space.shape), low, high).astype(np.float32)
-            _, _, te, tr, _ = env.step(a)
-            nat.append(float(env.log[-1]["r_naturalness"]) if env.log else math.nan)
-            if before >= 1 and len(seen) > before and len(env.log) > 1:
-                change.append(float(np.mean(np.abs(seen[-1] - seen[-2]))))
-            if te or tr:
-                env.reset(seed=0, options={"kind": "clip", "curve": "facedown"})
-    finally:
-        del space.targets
-    return {"r_natural": float(np.nanmean(nat)), "target_change": float(np.mean(change)) if change else math.nan}

@@ -60,6 +60,8 @@ class JumpTask(PolicyTask):
         "success", "root_ang_vel_mean", "head_first_landing", "naturalness", "feature", "policy_features"})
     #: what a curriculum may drive: the jump's own difficulty, the control rate, the P-VAE's offset
     curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"bar_height", "control_hz", "c_offset"})
+    #: ``jt study highjump TOOL`` (and obstacle, longjump): the analysis tools (``jt_tasks.jumping.analysis``)
+    studies: ClassVar[dict[str, str]] = {"curves": "jt_tasks.jumping.analysis.curves:main"}
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

@@ -43,6 +43,14 @@ class SpacetimeTask(PolicyTask):
     #: no periodic Table 1 evaluation, a 1 s final one (a benchmark's)
     cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0", "eval_every": str(10 ** 9),
                                                   "eval_time_limit": "1.0"}
+    #: ``jt study spacetime TOOL``: the analysis tools (``jt_tasks.spacetime.analysis``)
+    studies: ClassVar[dict[str, str]] = {
+        "survival": "jt_tasks.spacetime.analysis.survival_plot:main",
+        "bounds": "jt_tasks.spacetime.analysis.bounds_study:main",
+        "policy-bounds": "jt_tasks.spacetime.analysis.policy_bounds:main",
+        "style": "jt_tasks.spacetime.analysis.style_study:main",
+        "toy": "jt_tasks.spacetime.analysis.toy:main",
+    }
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:

@@ -38,6 +38,9 @@ class StandingJumpTask(Task):
     needs_spd_torques: ClassVar[bool] = True  #: it adds the virtual-force torques and applies the limits itself
 
     key_metrics: ClassVar[tuple[str, ...]] = ("hypervolume", "max_natural_height", "max_height", "n_front")
+    #: ``jt study standing_jump TOOL``: the analysis tools (``jt_tasks.standing_jump.analysis``)
+    studies: ClassVar[dict[str, str]] = {"hypervolume": "jt_tasks.standing_jump.analysis.study:main",
+                                         "bench": "jt_tasks.standing_jump.analysis.bench:main"}
 
     @dataclasses.dataclass
     class Config:

@@ -1,7 +1,9 @@
-"""Where a get-up policy stops (issue 29): what a trained ``task=getup`` policy does from each kind of
-start, and how far the clips themselves get without feedback.
+"""Where a trained task=getup policy stops, from each kind of start, beside the clips played open loop.
 
-``python -m jt_tasks.getup.study RUN --store DIR [--out FOLDER]`` prints, for the run's policy (its
+Issue 29: what a trained ``task=getup`` policy does from each kind of start, and how far the clips
+themselves get without feedback.
+
+``jt study getup policy RUN --store DIR [--out FOLDER]`` prints, for the run's policy (its
 ``ppo.h5``), the deterministic episode from the clip starts at 0, 25, 50, 75 and 90 % of the clip
 (the curve's clock set there, ``task.rsi``'s starts) and from standing: control steps lived, why it
 ended, the highest neck height, whether it got up; then the same for the open-loop clip (every PD
@@ -14,12 +16,16 @@ until the episode ends (``standing_balance``).
 
 from __future__ import annotations
 
-import argparse
 import math
 from pathlib import Path
-from typing import Any, NoReturn, Optional
+from typing import Any, Optional, Sequence
 
 import numpy as np
+
+from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser, writable_folder
+
+PROG = "jt study getup policy"
 
 FRACTIONS = (0.0, 0.25, 0.5, 0.75, 0.9)  #: clip starts, as shares of the clip's duration
 
@@ -104,8 +110,13 @@ def plot_history(ppo_h5: Path, out: Path) -> Optional[Path]:
     import h5py
     import matplotlib
 
+    from jt_tasks.getup.task import HISTORY
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    def col(name: str) -> int:  # the history's rows are (samples, *HISTORY)
+        return 1 + HISTORY.index(name)
 
     with h5py.File(ppo_h5, "r") as f:
         hist = f["extra/getup_history"][:] if "extra/getup_history" in f else None
@@ -113,9 +124,9 @@ def plot_history(ppo_h5: Path, out: Path) -> Optional[Path]:
     if hist is None or not len(hist):
         return None
     fig, ax = plt.subplots(1, 2, figsize=(9, 3.2))
-    ax[0].plot(hist[:, 0] / 1e6, hist[:, 4], label="task return rate (ground starts)")
-    ax[0].plot(hist[:, 0] / 1e6, hist[:, 3], label="mean r_task")
-    ax[0].plot(hist[:, 0] / 1e6, hist[:, 5], label="share ended early")
+    ax[0].plot(hist[:, 0] / 1e6, hist[:, col("task_return_rate")], label="task return rate (ground starts)")
+    ax[0].plot(hist[:, 0] / 1e6, hist[:, col("r_task_mean")], label="mean r_task")
+    ax[0].plot(hist[:, 0] / 1e6, hist[:, col("early")], label="share ended early")
     ax[0].set_xlabel("samples (M)")
     ax[0].legend(fontsize=7)
     if ev is not None and len(ev):
@@ -132,21 +143,16 @@ def plot_history(ppo_h5: Path, out: Path) -> Optional[Path]:
     return path
 
 
-def _fail(message: str) -> NoReturn:
-    """A user's mistake: one line on stderr, exit status 2."""
-    import sys
+@one_line_errors
+def main(argv: Optional[Sequence[str]] = None) -> None:
+    from omegaconf import OmegaConf
 
-    print(f"study: {message}", file=sys.stderr)
-    raise SystemExit(2)
-
-
-def main(argv: Optional[list[str]] = None) -> None:
     from toolkit import plugins
     from toolkit.config import validate
     from toolkit.rl.checkpoint import load_policy
     from toolkit.store.resolve import resolve, run_config
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = parser(PROG, __doc__.split("\n")[0])
     ap.add_argument("run", help="a task=getup run id (its best evaluation), a folder or a ppo.h5")
     ap.add_argument("--store", default=None, help="the store the run is in")
     ap.add_argument("--out", default=None, help="a folder for getup_history.png")
@@ -157,23 +163,16 @@ def main(argv: Optional[list[str]] = None) -> None:
                     help="clip starts at these fractions of the clip, in [0, 1) (default: 0 0.25 0.5 0.75 0.9)")
     args = ap.parse_args(argv)
     if args.stand is not None and not (math.isfinite(args.stand) and args.stand > 0):
-        _fail(f"--stand={args.stand}: the seconds of standing must be a finite number > 0 (e.g. --stand 10)")
+        raise JtError(f"--stand={args.stand}: the seconds of standing must be a finite number > 0 (e.g. --stand 10)")
     bad = [a for a in args.at if not (math.isfinite(a) and 0.0 <= a < 1.0)]
     if bad:
-        _fail(f"--at={bad[0]}: a clip start is a fraction of the clip in [0, 1) (e.g. --at 0.5 0.75)")
-    from toolkit.errors import JtError
-
-    try:
-        ref = resolve(args.run, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
-    except JtError as e:
-        _fail(str(e))
-    from omegaconf import OmegaConf
-
-    try:
-        found = run_config(ref.path, args.config)
-    except JtError as e:
-        _fail(str(e))
-    task = plugins.load("task", "getup")(validate(OmegaConf.load(found)))
+        raise JtError(f"--at={bad[0]}: a clip start is a fraction of the clip in [0, 1) (e.g. --at 0.5 0.75)")
+    ref = resolve(args.run, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
+    cfg = validate(OmegaConf.load(run_config(ref.path, args.config)))
+    if cfg.task.name != "getup":
+        raise JtError(f"{args.run}: a task={cfg.task.name} run; {PROG} reads task=getup runs")
+    out = None if args.out is None else writable_folder(args.out, "--out")
+    task = plugins.load("task", "getup")(cfg)
     env = task.make_env(None, seed=0)
     try:
         model = load_policy(ref.path)
@@ -192,9 +191,7 @@ def main(argv: Optional[list[str]] = None) -> None:
         o = open_loop_clip(clip, sim_groups)
         print(f"open loop {clip}: h_max {o['h_max']:.2f} m at {o['t_h_max']:.2f} s of {o['duration']:.2f}, "
               f"h at the end {o['h_end']:.2f} m")
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
+    if out is not None:
         print(plot_history(Path(ref.path), out))
 
 

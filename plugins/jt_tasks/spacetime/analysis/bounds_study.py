@@ -1,9 +1,10 @@
-"""What early termination by the bounds saves (002 §3.2; issue 12, measurement 3).
+"""What early termination by the bounds saves: the FFC alone, bounds off, per clip (002 §3.2; issue 12).
 
 Under a fixed policy, the feed-forward controller alone (zero correction, ``action=ffc_fbc``),
 each clip is played from ``n_starts`` evenly spread phases with the bounds *off* (the
 evaluation's set-up: only a forbidden ground contact or the time limit ends the episode), and
-the 22-channel difference to the reference is checked after every control step. Per episode:
+the 22-channel difference to the reference is checked after every control step (issue 12,
+measurement 3). Per episode:
 
 * ``first``: the control step of the first bound violation (None: never out of bounds);
 * ``after``: control steps from the first violation to the episode's end;
@@ -12,18 +13,20 @@ the 22-channel difference to the reference is checked after every control step. 
 
 The share ``lost / after`` (summed over starts) is what the bounds save::
 
-    python -m jt_tasks.spacetime.bounds_study --clips walk run jump roll cartwheel backflip dance_a \\
-        --starts 5 --seconds 4
+    jt study spacetime bounds --clips walk run jump roll cartwheel backflip dance_a --starts 5 --seconds 4
 """
 
 from __future__ import annotations
 
-import argparse
+import math
 from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from toolkit.errors import one_line_errors
+from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser
+
+PROG = "jt study spacetime bounds"
 
 CLIPS = ("walk", "run", "jump", "roll", "cartwheel", "backflip", "dance_a")
 
@@ -83,11 +86,22 @@ def study(clips: Sequence[str] = CLIPS, n_starts: int = 5, seconds: float = 4.0)
 
 @one_line_errors
 def main(argv: Optional[Sequence[str]] = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--clips", nargs="+", default=list(CLIPS))
-    ap.add_argument("--starts", type=int, default=5)
-    ap.add_argument("--seconds", type=float, default=4.0)
+    from jt_tasks.spacetime.reference import resolve_clip
+
+    ap = parser(PROG, __doc__.split("\n")[0])
+    ap.add_argument("--clips", nargs="+", default=list(CLIPS), help=f"the clips (default: {' '.join(CLIPS)})")
+    ap.add_argument("--starts", type=int, default=5, help="start phases k / starts per clip (default 5)")
+    ap.add_argument("--seconds", type=float, default=4.0, help="seconds per episode at most (default 4)")
     args = ap.parse_args(argv)
+    if args.starts < 1:
+        raise JtError(f"--starts={args.starts}: at least 1 start phase")
+    if not (math.isfinite(args.seconds) and args.seconds > 0):
+        raise JtError(f"--seconds={args.seconds}: a finite number of seconds > 0 (e.g. --seconds 3)")
+    for clip in args.clips:  # every clip found before the first episode
+        try:
+            resolve_clip(clip)
+        except JtError as e:
+            raise JtError(f"--clips: {e}") from None
     rows = study(args.clips, args.starts, args.seconds)
     print("| clip | episodes | steps | left the bounds | first violation (median, s) | steps after it | never back inside | share |")
     print("|---|---|---|---|---|---|---|---|")

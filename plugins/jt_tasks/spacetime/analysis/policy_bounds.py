@@ -1,6 +1,6 @@
-"""Which bound a trained policy breaks, and when (issue 28): Table 1's evaluation with the bounds watched.
+"""Which bound a trained task=spacetime policy leaves first, and when: Table 1's evaluation, bounds watched.
 
-A ``task=spacetime`` run's deterministic policy (its ``ppo.h5``) is played from ``starts`` start
+Issue 28: a ``task=spacetime`` run's deterministic policy (its ``ppo.h5``) is played from ``starts`` start
 phases spread evenly from 0, as Table 1's evaluation does (bounds off: only a forbidden ground
 contact or the 20 s limit ends the episode), and after every control step the 22-channel
 difference to the reference is checked against the bounds the run trained under. Per start: the
@@ -8,7 +8,7 @@ seconds survived, the first channels to leave their bounds (with the time), and 
 largest ``|difference| / width`` over the episode. A policy that walks 20 s but leaves a bound at
 1 s would have had every training episode cut there::
 
-    python -m jt_tasks.spacetime.policy_bounds RUN --store DIR [--starts 4] [--seconds 20]
+    jt study spacetime policy-bounds RUN --store DIR [--starts 4] [--seconds 20]
 
 ``RUN`` is a run id (the store's), a folder holding ``ppo.h5`` or the file; the run's
 ``config.yaml`` beside it gives the task (``--config`` to name another).
@@ -16,13 +16,15 @@ largest ``|difference| / width`` over the episode. A policy that walks 20 s but 
 
 from __future__ import annotations
 
-import argparse
 import math
 from typing import Any, Optional, Sequence
 
 import numpy as np
 
 from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser
+
+PROG = "jt study spacetime policy-bounds"
 
 
 def watch(env: Any, policy: Any, phase: float, max_steps: Optional[int] = None) -> dict[str, Any]:
@@ -79,7 +81,7 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     from toolkit.rl.checkpoint import load_policy
     from toolkit.store.resolve import resolve, run_config
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = parser(PROG, __doc__.split("\n")[0])
     ap.add_argument("run", help="a task=spacetime run id, a folder holding ppo.h5, or the file")
     ap.add_argument("--store", default=None, help="the store the run is in")
     ap.add_argument("--config", default=None, help="the run's config.yaml (default: the one beside its ppo.h5)")
@@ -93,7 +95,7 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     ref = resolve(args.run, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
     cfg = validate(OmegaConf.load(run_config(ref.path, args.config)))
     if cfg.task.name != "spacetime":
-        raise JtError(f"run {args.run}: a task={cfg.task.name} run; this study reads task=spacetime runs")
+        raise JtError(f"{args.run}: a task={cfg.task.name} run; {PROG} reads task=spacetime runs")
     env = plugins.load("task", "spacetime")(cfg).make_env(None, seed=0)
     try:
         policy = load_policy(ref.path)

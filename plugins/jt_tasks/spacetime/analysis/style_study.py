@@ -1,4 +1,4 @@
-"""Style measures of finished spacetime runs over the first seconds of their evaluation (002 §3.3).
+"""Style measures (hull volume, energy) of finished task=spacetime runs over their first seconds (002 §3.3).
 
 A run logs ``style_energy`` / ``style_volume`` (and the reference's ``ref_*``) over its whole final
 evaluation, which ends when the character falls; a fall changes both measures. This replays each
@@ -6,17 +6,20 @@ run's final policy (its ``ppo.h5`` and ``config.yaml`` artifacts, the determinis
 itself made: same start, same seed) and measures the style over windows from the start, beside
 the reference's at the same clip times, with the same estimators (``artifacts.style_measures``)::
 
-    python -m jt_tasks.spacetime.style_study RUN_ID [RUN_ID ...] --store DIR --seconds 0.5 1 1.5
+    jt study spacetime style RUN_ID [RUN_ID ...] --store DIR --seconds 0.5 1 1.5
 
 The last row of each run (window ``all``) is the whole evaluation: it equals the logged metrics.
 """
 
 from __future__ import annotations
 
-import argparse
+import math
 from typing import Any, Optional, Sequence
 
 from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser
+
+PROG = "jt study spacetime style"
 
 
 def replay(config: Any, checkpoint: str) -> tuple[Any, Any]:
@@ -58,16 +61,20 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
     from toolkit.store.tracking import store_root
 
     st = open_store(store_root(store), must_exist=True)
-    out = []
-    for rid in run_ids:
+    arts = []
+    for rid in run_ids:  # every run checked before the first replay
         run = st.get_run(rid)  # an unknown id is one JtError line
         task = run.data.tags.get("jt.task")
         if task != "spacetime":
-            raise JtError(f"run {rid} is a {task or 'non-jt'} run; style_study replays task=spacetime runs")
+            raise JtError(f"run {rid} is a {'task=' + task if task else 'non-jt'} run; "
+                          f"{PROG} replays task=spacetime runs")
         art = st.artifact_dir(rid)
         if not (art / "ppo.h5").is_file() or not (art / "config.yaml").is_file():
             raise JtError(f"run {rid} has no ppo.h5 and config.yaml among its artifacts ({run.info.status}); "
-                          "style_study needs a finished run")
+                          f"{PROG} needs a finished run")
+        arts.append((rid, art))
+    out = []
+    for rid, art in arts:
         env, ro = replay(OmegaConf.load(art / "config.yaml"), str(art / "ppo.h5"))
         try:
             for row in windows(env, ro, [*seconds, None]):
@@ -79,11 +86,15 @@ def study(run_ids: Sequence[str], store: Optional[str], seconds: Sequence[float]
 
 @one_line_errors
 def main(argv: Optional[Sequence[str]] = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = parser(PROG, __doc__.split("\n")[0])
     ap.add_argument("runs", nargs="+", help="run ids of finished spacetime runs")
     ap.add_argument("--store", default=None, help="the store (default: $JT_STORE, else ./artifacts)")
-    ap.add_argument("--seconds", nargs="*", type=float, default=[0.5, 1.0, 1.5])
+    ap.add_argument("--seconds", nargs="*", type=float, default=[0.5, 1.0, 1.5],
+                    help="windows from the start, in seconds (default: 0.5 1 1.5); the whole evaluation is added")
     args = ap.parse_args(argv)
+    bad = [w for w in args.seconds if not (math.isfinite(w) and w > 0)]
+    if bad:
+        raise JtError(f"--seconds={bad[0]}: a window is a finite number of seconds > 0 (e.g. --seconds 1)")
     rows = study(args.runs, args.store, args.seconds)  # errors before any output
     print("| run | survival (s) | window (s) | steps | volume / reference (m³) | energy / reference (J) |")
     print("|---|---|---|---|---|---|")

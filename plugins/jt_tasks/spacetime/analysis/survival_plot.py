@@ -1,10 +1,10 @@
-"""Survival against samples for ``task=spacetime`` runs (002 Table 1's curve), one line per run.
+"""Survival against samples of task=spacetime runs (002 Table 1's curve), one line per run.
 
 Every run keeps Table 1's evaluation rows in its ``ppo.h5`` (``extra/eval_history``: samples, mean
 survival over the start phases, share of starts that survived, worst start; ``training.py``), so a
 finished, stopped or running run can be drawn::
 
-    python -m jt_tasks.spacetime.survival_plot RUN[=LABEL] [RUN[=LABEL] ...] --store DIR --out FILE.png
+    jt study spacetime survival RUN[=LABEL] [RUN[=LABEL] ...] --store DIR --out FILE.png
 
 ``RUN`` is a run id (the store's), a folder holding ``ppo.h5`` or the file (a running or stopped
 run's newest checkpoint is ``<store>/work/<run id>/eval_0000/ppo.h5``). The plot draws each run's
@@ -15,13 +15,15 @@ time limit, or ``-``) and its last evaluation.
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 from typing import Optional, Sequence
 
 import numpy as np
 
 from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser, require_task, writable_file
+
+PROG = "jt study spacetime survival"
 
 
 def read_rows(ppo_h5: Path) -> np.ndarray:
@@ -32,9 +34,12 @@ def read_rows(ppo_h5: Path) -> np.ndarray:
     """
     import h5py
 
-    with h5py.File(ppo_h5, "r") as f:
-        key = "extra/eval_history"
-        rows = np.asarray(f[key][:], dtype=float) if key in f else np.zeros((0, 4))
+    try:
+        with h5py.File(ppo_h5, "r") as f:
+            key = "extra/eval_history"
+            rows = np.asarray(f[key][:], dtype=float) if key in f else np.zeros((0, 4))
+    except OSError as e:
+        raise JtError(f"{ppo_h5}: not a readable ppo.h5 ({e})") from None
     if rows.ndim != 2 or rows.shape[1] != 4 or not len(rows):
         raise JtError(f"{ppo_h5}: no Table 1 evaluation in it (a task=spacetime run evaluates every "
                       "task.eval_every iterations; this one has none yet)")
@@ -82,7 +87,7 @@ def plot(curves: Sequence[tuple[str, np.ndarray]], out: Path, title: str = "", l
 def main(argv: Optional[Sequence[str]] = None) -> None:
     from toolkit.store.resolve import resolve
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = parser(PROG, __doc__.split("\n")[0])
     ap.add_argument("runs", nargs="+", metavar="RUN[=LABEL]",
                     help="task=spacetime run ids, folders holding ppo.h5 or the files, each with an optional =label")
     ap.add_argument("--store", default=None, help="the store the runs are in")
@@ -95,12 +100,14 @@ def main(argv: Optional[Sequence[str]] = None) -> None:
     for item in args.runs:
         ref, _, label = item.partition("=")
         found = resolve(ref, artifact="ppo.h5", store=args.store, what="run", label="trained policy")
+        require_task(found, ref, "spacetime", PROG)
         rows = read_rows(found.path)
         curves.append((label or (found.run_id[:8] if found.run_id else Path(ref).stem), rows))
+    out = None if args.out is None else writable_file(args.out, "--out")
     for label, rows in curves:
         print(summary(label, rows))
-    if args.out is not None:
-        print(f"plot: {plot(curves, Path(args.out), args.title)}")
+    if out is not None:
+        print(f"plot: {plot(curves, out, args.title)}")
 
 
 if __name__ == "__main__":

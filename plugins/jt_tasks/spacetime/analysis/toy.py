@@ -1,4 +1,4 @@
-"""The toy problem of 002 §3.1 (Fig. 2, eq 1): feasible regions of a mass point under spacetime bounds.
+"""Fig. 2's toy (002 §3.1, eq 1): feasible regions of a mass point under spacetime bounds, in closed form.
 
 A mass point on the x axis, state ``(x, v)``, acceleration ``|a| <= a_max`` (2 m/s², 002 §3.1).
 Events and bounds are axis-aligned boxes in ``(x, v)`` at one time each (``Box``; an event is a
@@ -26,17 +26,21 @@ The paper's setting (002 §3.1): ``e1 = (0, 0)`` at ``t = 0``, ``e2 = (0, 0)`` a
 ``v ∈ [-1, 1]`` at ``T2 = 10/3`` (eq 1). The figure's view (3-D slices) is ours; the paper
 gives only the sets. ::
 
-    python -m jt_tasks.spacetime.toy --out DIR     # DIR/fig2_toy.png
+    jt study spacetime toy --out DIR     # DIR/fig2_toy.png
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 from pathlib import Path
 from typing import Optional, Sequence
 
 import numpy as np
+
+from toolkit.errors import one_line_errors
+from toolkit.study import parser, writable_folder
+
+PROG = "jt study spacetime toy"
 
 A_MAX = 2.0
 """m/s², the acceleration cap (002 §3.1)."""
@@ -229,13 +233,15 @@ def plot_fig2(out: Path, times: Optional[Sequence[float]] = None,
     return out
 
 
+@one_line_errors
 def main(argv: Optional[Sequence[str]] = None) -> None:
-    ap = argparse.ArgumentParser(description="002 Fig. 2: the toy problem's feasible regions (fig2_toy.png)")
-    ap.add_argument("--out", default=".", help="folder for fig2_toy.png")
+    ap = parser(PROG, "002 Fig. 2: the toy problem's feasible regions (fig2_toy.png) and their volumes")
+    ap.add_argument("--out", default=".", help="folder for fig2_toy.png (default: the current one)")
     args = ap.parse_args(argv)
+    out = writable_folder(args.out, "--out")
     times = default_times()
     regions = toy_regions(times)
-    path = plot_fig2(Path(args.out) / "fig2_toy.png", times, regions)
+    path = plot_fig2(out / "fig2_toy.png", times, regions)
     for name, polys in regions.items():
         vol = sum(area(p) for p in polys) * (times[1] - times[0])
         at_t1 = area(polys[int(np.argmin(np.abs(times - B1.t)))])

@@ -1,17 +1,22 @@
-"""Benchmark: seconds per standing-jump evaluation (one simulation), and where the time goes.
+"""Seconds per standing-jump evaluation (one simulation), and where the time goes: a benchmark.
 
-Run ``python -m jt_tasks.standing_jump.bench [--n 10] [--sim-hz 600] [--spd maba]``. Speed is measured here,
-never in tests. Evaluations are the seed controller and seeded perturbations of it (successes and
-failures both count: a search evaluates both).
+Run ``jt study standing_jump bench [--n 10] [--sim-hz 600] [--spd maba] [--json FILE]``. Speed is
+measured here, never in tests. Evaluations are the seed controller and seeded perturbations of it
+(successes and failures both count: a search evaluates both).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
+import math
 import platform
 import time
-from typing import Any
+from typing import Any, Optional, Sequence
+
+from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser, writable_file
+
+PROG = "jt study standing_jump bench"
 
 
 def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, seed: int = 0,
@@ -60,21 +65,33 @@ def time_evaluations(n: int = 10, sim_hz: float = 600.0, sigma: float = 0.03, se
     return res
 
 
-def main() -> None:  # pragma: no cover - command line
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=10)
-    ap.add_argument("--sim-hz", type=float, default=600.0)
-    ap.add_argument("--spd", type=str, default="maba", help="SPD backend: maba, df, sf or pcg")
-    ap.add_argument("--json", type=str, default="")
-    a = ap.parse_args()
+@one_line_errors
+def main(argv: Optional[Sequence[str]] = None) -> None:
+    from toolkit import plugins
+
+    ap = parser(PROG, __doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=10, help="evaluations (default 10: the seed and 9 perturbations)")
+    ap.add_argument("--sim-hz", type=float, default=600.0, help="simulation rate, Hz (default 600)")
+    ap.add_argument("--spd", type=str, default="maba", help="SPD backend (default maba; jt plugins spd lists them)")
+    ap.add_argument("--json", type=str, default="", help="also write the results as JSON here")
+    a = ap.parse_args(argv)
+    if a.n < 1:
+        raise JtError(f"--n={a.n}: at least 1 evaluation")
+    if not (math.isfinite(a.sim_hz) and a.sim_hz > 0):
+        raise JtError(f"--sim-hz={a.sim_hz}: a finite rate > 0 (e.g. --sim-hz 600)")
+    usable = [n for n in plugins.names("spd") if not getattr(plugins.load("spd", n), "steps_itself", False)]
+    if a.spd not in usable:  # the standing jump adds its own torques: not a backend that steps itself
+        raise JtError(f"--spd={a.spd}: not an SPD backend the standing jump can use; choose one of: "
+                      f"{', '.join(sorted(usable))}")
+    out = writable_file(a.json, "--json") if a.json else None
     res = time_evaluations(a.n, a.sim_hz, spd=a.spd)
     print(f"{a.n} evaluations at {a.sim_hz:g} Hz, spd={a.spd}: median wall {res['median_wall_s']:.3f} s, "
           f"median CPU {res['median_cpu_s']:.3f} s, {res['realtime_factor']:.1f}x real time, "
           f"{sum(res['success'])}/{a.n} successful")
-    if a.json:
-        with open(a.json, "w") as f:
+    if out is not None:
+        with open(out, "w") as f:
             json.dump(res, f, indent=2)
 
 
-if __name__ == "__main__":  # pragma: no cover
+if __name__ == "__main__":
     main()

@@ -1,22 +1,26 @@
-"""RMOO vs BSOO vs random search on the standing jump: hypervolume against simulations.
+"""RMOO vs BSOO vs random search on the standing jump: hypervolume against simulations, final fronts.
 
 Drives the searchers' ``ask``/``tell`` directly (no runner, no MLflow) with a process pool, and
 records the hypervolume of all successful samples so far after every evaluation (``004`` §5
-compares the fronts the two algorithms find, Fig. 8).
+compares the fronts the two algorithms find, Fig. 8)::
 
-    python -m jt_tasks.standing_jump.study --budget 192 --seeds 0 --workers 2 --out study
+    jt study standing_jump hypervolume --budget 192 --seeds 0 --workers 2 --out study
 
 writes ``study/study.json`` (curves, final fronts) and ``study/hypervolume.png``.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
+
+from toolkit.errors import JtError, one_line_errors
+from toolkit.study import parser, writable_folder
+
+PROG = "jt study standing_jump hypervolume"
 
 SEARCHERS = {  # label: (registry name, search config)
     # 004 §4.3 / §5: mu = 16, at most 3 failed children per generation
@@ -107,18 +111,23 @@ def plot(results: Sequence[dict], path: Path) -> None:
     plt.close(fig)
 
 
-def main() -> None:  # pragma: no cover - command line
+@one_line_errors
+def main(argv: Optional[Sequence[str]] = None) -> None:
     import multiprocessing as mp
 
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--budget", type=int, default=192)
-    ap.add_argument("--seeds", type=int, nargs="+", default=[0])
-    ap.add_argument("--searchers", nargs="+", default=["rmoo", "bsoo", "random"], choices=list(SEARCHERS))
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--out", type=str, default="study")
-    a = ap.parse_args()
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
+    ap = parser(PROG, __doc__.split("\n")[0])
+    ap.add_argument("--budget", type=int, default=192, help="simulations per search (default 192)")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="one search per searcher and seed (default 0)")
+    ap.add_argument("--searchers", nargs="+", default=["rmoo", "bsoo", "random"], choices=list(SEARCHERS),
+                    help="which searchers (default: rmoo bsoo random)")
+    ap.add_argument("--workers", type=int, default=2, help="processes simulating side by side (default 2)")
+    ap.add_argument("--out", type=str, default="study", help="folder for study.json and hypervolume.png")
+    a = ap.parse_args(argv)
+    if a.budget < 1:
+        raise JtError(f"--budget={a.budget}: at least 1 simulation")
+    if a.workers < 1:
+        raise JtError(f"--workers={a.workers}: at least 1 process")
+    out = writable_folder(a.out, "--out")
     results = []
     with mp.Pool(a.workers) as pool:
         for seed in a.seeds:
@@ -131,5 +140,5 @@ def main() -> None:  # pragma: no cover - command line
     plot(results, out / "hypervolume.png")
 
 
-if __name__ == "__main__":  # pragma: no cover
+if __name__ == "__main__":
     main()

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 
 def sim_groups() -> dict:
     return {"sim": {"name": "bullet", "friction": 1.0}, "spd": {"name": "df"}, "character": {"name": "humanoid"}}
@@ -18,3 +20,23 @@ def standing_sim() -> Any:
     q, qd = clip_pose("getup_facedown", False, frame=-1)
     sim.reset(q, qd)
     return sim
+
+
+def make_task(*overrides: str):
+    """A get-up task with raw actions, no fallen starts, flat ground and no curriculum (the stage-1 tests')."""
+    from toolkit import plugins
+    from toolkit.config import compose, validate
+
+    cfg = validate(compose(["task=getup", "action=raw", "task.n_fallen=0", "task.terrain=null", "~curriculum",
+                            "task.eval_regions=[flat]", *overrides]))
+    return plugins.load("task", "getup")(cfg)
+
+
+class Still:
+    """A policy that holds every PD target at zero offset (raw actions: the rest pose)."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        return np.zeros(self.n)

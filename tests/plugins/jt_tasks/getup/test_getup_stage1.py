@@ -8,14 +8,7 @@ import pytest
 
 from toolkit.errors import JtError
 
-
-def make_task(*overrides: str):
-    from toolkit import plugins
-    from toolkit.config import compose, validate
-
-    cfg = validate(compose(["task=getup", "action=raw", "task.n_fallen=0", "task.terrain=null", "~curriculum",
-                            "task.eval_regions=[flat]", *overrides]))
-    return plugins.load("task", "getup")(cfg)
+from tests.plugins.jt_tasks.getup.getup_helpers import Still, make_task
 
 
 @pytest.fixture(scope="module")
@@ -92,22 +85,12 @@ def test_clip_start_options_cycle_the_clip_curves_with_their_own_seeds():
         clip_start_options(build_curves(["situp_roll"], {}, None), 2, 0.05)
 
 
-class _Still:
-    """A policy that holds every PD target at zero offset (raw actions: the rest pose)."""
-
-    def __init__(self, n: int) -> None:
-        self.n = n
-
-    def act(self, obs: np.ndarray) -> np.ndarray:
-        return np.zeros(self.n)
-
-
 def test_an_untrained_policy_does_not_get_up_from_clip_starts():
     from jt_tasks.getup.stage1 import clip_start_success
 
     e = make_task("task.curves=[facedown,faceup]").make_env(None, seed=0)
     try:
-        res = clip_start_success(e, _Still(e.action_space.shape[0]), 2, 0.05)
+        res = clip_start_success(e, Still(e.action_space.shape[0]), 2, 0.05)
     finally:
         e.close()
     assert res["success"] == 0.0 and res["got_up"] == 0.0 and len(res["infos"]) == 2
@@ -126,60 +109,3 @@ def test_an_untrained_policy_does_not_get_up_from_clip_starts():
 def test_bad_values_are_one_line(override, match):
     with pytest.raises(JtError, match=match):
         make_task("task.eval_clip_starts=4", *override.split())
-
-
-def test_the_clip_tracked_without_feedback_does_not_get_up():
-    """What a policy must add (issue 29, jt_tasks.getup.study): PD targets set to the facedown clip's
-    poses, no policy, lift the neck off the ground (> 0.3 m) but never to a standing height
-    (0.8 x 1.35 m), and the character ends lying again."""
-    from jt_tasks.getup.study import open_loop_clip
-
-    from tests.plugins.jt_tasks.getup.getup_helpers import sim_groups
-
-    o = open_loop_clip("getup_facedown", sim_groups(), t_stand=1.0)
-    assert 0.3 < o["h_max"] < 0.8 * 1.35 and o["h_end"] < 0.3 and o["duration"] == pytest.approx(3.03, abs=0.01)
-
-
-def test_standing_balance_gives_each_curve_its_standing_start_and_restores_t_stand():
-    """``study --stand``: a policy that holds the rest pose (raw zero action, no feedback) falls from
-    every standing start well before 4 s (a PD-held pose falls in ~2 s, docs/getup.md), and the
-    measurement leaves the env's 3 s standing phase as it found it."""
-    from jt_tasks.getup.study import standing_balance
-
-    e = make_task("task.curves=[facedown,faceup]", "task.p_standing=1", "task.p_fallen=0").make_env(None, seed=0)
-    try:
-        rows = standing_balance(e, _Still(e.action_space.shape[0]), 4.0)
-        assert e.spec_.t_stand == 3.0
-    finally:
-        e.close()
-    assert [r["curve"] for r in rows] == ["facedown", "faceup"] and all(r["of"] == 120 for r in rows)
-    assert all(10 < r["steps"] < 120 and r["reason"] != "time limit" for r in rows)
-
-
-@pytest.mark.parametrize("argv,match", [
-    (["RUN", "--stand", "0"], "--stand=0.0: the seconds of standing must be a finite number > 0"),
-    (["RUN", "--stand", "nan"], "--stand=nan"),
-    (["/no/such/ppo.h5", "--stand", "10"], "no such file"),
-    (["RUN", "--at", "0.5", "1.0"], "--at=1.0: a clip start is a fraction of the clip in [0, 1)"),
-])
-def test_study_refuses_a_bad_value_in_one_line_with_exit_2(argv, match, capsys):
-    from jt_tasks.getup.study import main
-
-    with pytest.raises(SystemExit) as e:
-        main(argv)
-    err = capsys.readouterr().err
-    assert e.value.code == 2 and match in err and len(err.strip().splitlines()) == 1
-
-
-def test_policy_starts_at_chosen_fractions_say_what_a_success_needs():
-    """``study --at``: episodes from the clip at the given fractions, each with the control steps a
-    success lasts from there; the rest-pose policy lasts fewer than that from every one."""
-    from jt_tasks.getup.study import policy_starts
-
-    e = make_task("task.curves=[facedown,faceup]").make_env(None, seed=0)
-    try:
-        rows = policy_starts(e, _Still(e.action_space.shape[0]), curves=("facedown",), fractions=(0.8,))
-    finally:
-        e.close()
-    assert [r["start"] for r in rows] == ["clip at 80%", "standing"]
-    assert rows[0]["needs"] == round((0.2 * e.curves[0].duration + 3.0) * 30) and rows[0]["steps"] < rows[0]["needs"]

@@ -50,7 +50,7 @@ def test_tiny_evaluation_writes_artifacts_and_resumes(tmp_path):
         np.testing.assert_array_equal(np.asarray(w0[k]), np.asarray(g2["policy"][k]))
     assert ev2.metrics.get("strategy_angle", math.nan) == pytest.approx(ev.metrics.get("strategy_angle", math.nan), nan_ok=True)
     # the learning-curve reader sees the same iterations as the evaluation's history
-    from jt_tasks.jumping import curves
+    from jt_tasks.jumping.analysis import curves
 
     c = curves.read(tmp_path / "ppo.h5")
     assert len(c["samples"]) == ev.metrics["iterations"] and c["samples"][-1] == ev.metrics["samples"]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jt_tasks.spacetime import bounds_study, policy_bounds
-from spacetime_helpers import make_env
+from jt_tasks.spacetime.analysis import bounds_study, policy_bounds
+from tests.plugins.jt_tasks.spacetime.spacetime_helpers import make_env
 
 
 class _FFCAlone:
@@ -56,8 +56,19 @@ def test_a_trained_runs_policy_is_reported_per_start(tmp_path, capsys):
     (["nosuchrun", "--store", "{tmp}"], "run=nosuchrun: no such run"),
     (["{tmp}/x.h5", "--starts", "0"], "--starts=0: at least 1"),
     (["{tmp}/x.h5", "--seconds", "nan"], "--seconds=nan: a finite number"),
+    (["{tmp}/getup/ppo.h5"], "{tmp}/getup/ppo.h5: a task=getup run; jt study spacetime policy-bounds reads "
+                             "task=spacetime runs"),
+    (["{tmp}/x.h5", "--starts"], "jt study spacetime policy-bounds: argument --starts: expected one argument"),
 ])
 def test_bad_input_is_one_line(tmp_path, capsys, argv, match):
+    from omegaconf import OmegaConf
+
+    from toolkit.config import compose
+
+    (tmp_path / "getup").mkdir()
+    (tmp_path / "getup" / "ppo.h5").write_bytes(b"never read")
+    OmegaConf.save(compose(["task=getup", "experiment=smoke"]), tmp_path / "getup" / "config.yaml")
+    match = match.replace("{tmp}", str(tmp_path))
     with pytest.raises(SystemExit) as e:
         policy_bounds.main([a.replace("{tmp}", str(tmp_path)) for a in argv])
     assert e.value.code == 2

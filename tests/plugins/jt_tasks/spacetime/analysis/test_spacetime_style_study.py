@@ -8,7 +8,7 @@ import pytest
 
 
 def test_replay_reproduces_the_logged_style_measures_and_windows_are_prefixes(tmp_path):
-    from jt_tasks.spacetime import style_study
+    from jt_tasks.spacetime.analysis import style_study
     from toolkit import plugins
     from toolkit.config import compose
     from toolkit.interfaces.task import EvalContext
@@ -32,12 +32,13 @@ def test_replay_reproduces_the_logged_style_measures_and_windows_are_prefixes(tm
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys):
     """No store, an unknown run id: one ``jt:`` line on stderr, status 2, nothing printed before it."""
-    from jt_tasks.spacetime import style_study
+    from jt_tasks.spacetime.analysis import style_study
     from toolkit.store.tracking import Store
 
     Store(tmp_path / "store")  # a real, empty store
     for argv, said in ((["abc", "--store", str(tmp_path / "none")], "no jt store at"),
-                       (["abc", "--store", str(tmp_path / "store")], "no run 'abc'")):
+                       (["abc", "--store", str(tmp_path / "store")], "no run 'abc'"),
+                       (["abc", "--seconds", "0"], "--seconds=0.0: a window is a finite number of seconds > 0")):
         with pytest.raises(SystemExit) as e:
             style_study.main(argv)
         out, err = capsys.readouterr()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jt_tasks.spacetime import survival_plot
+from jt_tasks.spacetime.analysis import survival_plot
 
 
 @pytest.fixture(scope="module")
@@ -43,12 +43,25 @@ def test_samples_to_20s_is_the_first_evaluation_all_starts_survived():
     (["nosuchrun", "--store", "{tmp}"], "run=nosuchrun: no such run"),
     (["{tmp}/x.h5", "--out", "{tmp}/s.pdf"], "--out={tmp}/s.pdf: the plot is a .png"),
     (["{tmp}/empty.h5"], "no Table 1 evaluation in it"),
+    (["{tmp}/getup/ppo.h5"], "{tmp}/getup/ppo.h5: a task=getup run; jt study spacetime survival reads task=spacetime"),
+    (["{tmp}/noth5.h5"], "not a readable ppo.h5"),
+    (["{tmp}/getup/ppo.h5", "--out", "{tmp}/file/s.png"], "a task=getup run"),  # the input first
+    (["{tmp}/x.h5", "--out", "{tmp}/file/s.png"], "--out={tmp}/file/s.png: cannot write there"),
+    (["{tmp}/x.h5", "--nosuch"], "jt study spacetime survival: unrecognized arguments: --nosuch"),
 ])
 def test_bad_input_is_one_line(tmp_path, capsys, argv, match):
     import h5py
 
-    with h5py.File(tmp_path / "empty.h5", "w") as f:
-        f.create_dataset("history/mean_length", data=np.zeros(3))  # a ppo.h5 of another task
+    for name in ("empty.h5", "x.h5"):
+        with h5py.File(tmp_path / name, "w") as f:
+            f.create_dataset("history/mean_length", data=np.zeros(3))  # a ppo.h5 of another task
+    with h5py.File(tmp_path / "x.h5", "a") as f:
+        f.create_dataset("extra/eval_history", data=np.ones((2, 4)))
+    (tmp_path / "getup").mkdir()
+    (tmp_path / "getup" / "config.yaml").write_text("task:\n  name: getup\n")  # a run's work folder
+    (tmp_path / "getup" / "ppo.h5").write_bytes((tmp_path / "x.h5").read_bytes())
+    (tmp_path / "noth5.h5").write_text("not HDF5")
+    (tmp_path / "file").write_text("")
     with pytest.raises(SystemExit) as e:
         survival_plot.main([a.replace("{tmp}", str(tmp_path)) for a in argv])
     assert e.value.code == 2

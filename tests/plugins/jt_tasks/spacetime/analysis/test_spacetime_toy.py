@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jt_tasks.spacetime import toy
+from jt_tasks.spacetime.analysis import toy
 
 
 CHORD = 2e-3
@@ -111,3 +111,12 @@ def test_the_command_writes_fig2_toy_png(tmp_path, capsys):
     assert out.stat().st_size > 20_000
     text = capsys.readouterr().out
     assert "+ b1, b2" in text and str(out) in text
+
+
+def test_an_out_folder_that_cannot_be_written_is_one_line_before_the_regions(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(SystemExit) as e:
+        toy.main(["--out", str(tmp_path / "file")])
+    out, err = capsys.readouterr()
+    assert e.value.code == 2 and out == "" and err.startswith(f"jt: --out={tmp_path / 'file'}: cannot write there")
+    assert len(err.strip().splitlines()) == 1
