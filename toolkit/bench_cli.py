@@ -23,21 +23,12 @@ def _split(value: str, valid: "tuple[str, ...] | list[str]", what: str) -> list[
 
 
 def writable(path: Optional[Path], option: str) -> None:
-    """One ``JtError`` line, before any work, when ``path`` cannot be written (its folder is
-    created as writing would create it; a file made for the check is removed again)."""
-    if path is None:
-        return
-    existed = path.exists()
-    try:
-        if path.is_dir():
-            raise IsADirectoryError(21, "is a folder")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "a"):
-            pass
-    except OSError as e:
-        raise JtError(f"{option} {path}: cannot write there ({e.strerror or e}); give another path") from None
-    if not existed:
-        path.unlink()
+    """One ``JtError`` line, before any work, when ``path`` cannot be written (``toolkit.study``'s
+    check, which every analysis tool makes too)."""
+    if path is not None:
+        from toolkit.study import writable_file
+
+        writable_file(path, option)
 
 
 def check_rates(task: str, overrides: List[str], rates: List[float]) -> None:
