@@ -106,19 +106,25 @@ class FFCFBCActionSpace(DofActionSpace):
         super().__init__(cfg, character)
         from toolkit.motion.clips import load_clip
 
-        clip = load_clip(resolve_clip(self.params.clip))
-        if clip.skeleton.name != self.skeleton.name:
-            raise JtError(f"action=ffc_fbc: clip '{self.params.clip}' is for the {clip.skeleton.name}, "
-                          f"the character is the {self.skeleton.name}")  # fmt: skip
-        self.clip = clip
-        dofs = self.skeleton.joints_to_dofs(clip.joints)
-        for j, s in zip(self.skeleton.joints, self.skeleton.dof_slices.values()):
-            if j.kind == "spherical":
-                dofs[:, s] = unwrap_expmaps(dofs[:, s])
-        self._times = np.asarray(clip.times, dtype=np.float64)
-        self._time_list = [float(x) for x in self._times]
-        self._dofs = dofs
+        self._tracks: dict[int, tuple] = {}  # id(clip) -> (clip, times, time list, dofs): use_clip's memo
         self._phase = 0.0
+        self.use_clip(load_clip(resolve_clip(self.params.clip)), name=self.params.clip)
+
+    def use_clip(self, clip: Any, name: str = "") -> None:
+        """Track ``clip`` (a ``toolkit.motion.Clip`` of the same skeleton) from now on: a task whose
+        episodes follow different clips (``task=getup``: each curve's clip, mirrored or not) sets
+        the episode's clip at its start. The unwrapped dof track of each clip is kept."""
+        if id(clip) not in self._tracks:
+            if clip.skeleton.name != self.skeleton.name:
+                raise JtError(f"action=ffc_fbc: clip '{name or clip}' is for the {clip.skeleton.name}, "
+                              f"the character is the {self.skeleton.name}")  # fmt: skip
+            dofs = self.skeleton.joints_to_dofs(clip.joints)
+            for j, s in zip(self.skeleton.joints, self.skeleton.dof_slices.values()):
+                if j.kind == "spherical":
+                    dofs[:, s] = unwrap_expmaps(dofs[:, s])
+            times = np.asarray(clip.times, dtype=np.float64)
+            self._tracks[id(clip)] = (clip, times, [float(x) for x in times], dofs)
+        self.clip, self._times, self._time_list, self._dofs = self._tracks[id(clip)]
 
     @property
     def dim(self) -> int:

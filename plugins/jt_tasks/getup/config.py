@@ -116,6 +116,10 @@ class GetupConfig(PolicyConfig):
     """Deterministic get-ups per evaluation during training (the clip curves in turn)."""
     time_scale: float = 1.0
     """Default of the searched point: every curve's T times this (003 §4.3)."""
+    ffc_lead: int = 0
+    """With ``action=ffc_fbc`` (a feed-forward under the policy, ours, not 003: docs/getup.md): control steps the clip pose of the feed-forward target leads the curve's clock (002 §4.2: 0; spacetime's experiment=laptop: 1)."""
+    ffc_velocity: bool = False
+    """With ``action=ffc_fbc``: the clip's joint velocities at the feed-forward's time as the PD target velocities (ours, as spacetime's experiment=laptop; false: zero, 002 §4.2)."""
 
     def check(self) -> None:
         """One-line ``JtError`` for each mistake (unknown curve or style, control-point count ...)."""
@@ -202,6 +206,8 @@ class GetupConfig(PolicyConfig):
                 self.eval_locations, "an integer >= 1 (task.eval_regions=[] skips the Table 1 evaluation)")
         require(self.drop_hz is None or (finite(self.drop_hz) and self.drop_hz >= 30.0), "task.drop_hz", self.drop_hz,
                 "null or >= 30 Hz")
+        require(isinstance(self.ffc_lead, int) and self.ffc_lead >= 0, "task.ffc_lead", self.ffc_lead,
+                "control steps, an integer >= 0")
         require(self.heightmap_n >= 1, "task.heightmap_n", self.heightmap_n, "must be >= 1")
         require(0.0 < self.curve_match_deg <= 180.0, "task.curve_match_deg", self.curve_match_deg, "in (0, 180]")
         require(self.friction is None or (finite(self.friction) and self.friction >= 0), "task.friction",

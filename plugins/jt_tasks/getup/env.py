@@ -156,6 +156,10 @@ class GetupEnv(CharacterEnv):
         else:
             self.sim.reset(np.array(q), np.array(qd))
         self.action_space_.reset(None)
+        if hasattr(self.action_space_, "use_clip"):  # a feed-forward under the policy: this curve's clip (ours)
+            from jt_tasks.getup.curves import load_getup_clip
+
+            self.action_space_.use_clip(load_getup_clip(c.clip, c.mirrored), name=c.clip)
         self.curve_index, self.curve, self.start_kind = curve, c, kind
         # the curve's clock at the start: standing s = 1; a clip start inside the clip (rsi) its time
         self.t_offset = c.duration if kind == "standing" else (float(at) if kind == "clip" else 0.0)
@@ -297,15 +301,44 @@ class GetupEnv(CharacterEnv):
             self._ahead.flags.writeable = False
         return self._ahead
 
+    def clip_phase(self, t: float) -> float:
+        """The episode clip's phase ``[0, 1]`` at curve time ``t`` s (the clip's time scaled to the
+        curve's ``T``; 1, its last frame, held through the standing phase)."""
+        return min(max(float(t) / float(self.curve.duration), 0.0), 1.0)
+
+    def feedforward_time(self) -> float:
+        """Curve time (s) of the feed-forward target: now plus ``ffc_lead`` control steps."""
+        return self.t + float(self.spec_.ffc_lead) * self.dt
+
     # ------------------------------------------------------------------ gymnasium hooks
     def pd_targets(self, action: np.ndarray) -> np.ndarray:
         if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
             self.action_space_.set_condition(self.targets(self.t))
+        if hasattr(self.action_space_, "set_phase"):  # feed-forward: the clip's pose at the curve's clock (ours)
+            self.action_space_.set_phase(self.clip_phase(self.feedforward_time()))
         # the links now, as the observation of this state read them (the same state: no new query)
         self._prev_links = self._lv[:2] if self._lv is not None else self.sim.link_states()
         self._lv = None
         self.last_action = np.asarray(action, dtype=np.float64).copy()
         return super().pd_targets(action)
+
+    def pd_velocity_targets(self) -> Optional[np.ndarray]:
+        """With a feed-forward and ``ffc_velocity``: the clip's joint velocities ``(n_v,)`` at the
+        feed-forward's time, scaled to the curve's clock (root entries and the held last frame 0)."""
+        if not (self.spec_.ffc_velocity and hasattr(self.action_space_, "set_phase")):
+            return None
+        phase = self.clip_phase(self.feedforward_time())
+        if phase >= 1.0:
+            return np.zeros(self.sim.model.n_v)
+        from jt_tasks.getup.curves import load_getup_clip
+        from jt_tasks.takeoff.state import reference_state
+
+        clip = load_getup_clip(self.curve.clip, self.curve.mirrored)
+        length = float(clip.times[-1] - clip.times[0])
+        tc = float(clip.times[0]) + phase * length
+        tc = min(max(tc, float(clip.times[0]) + 1.0 / 120.0), float(clip.times[-1]) - 1.0 / 120.0)
+        jv = np.asarray(reference_state(clip, tc)[5], dtype=np.float64) * (length / float(self.curve.duration))
+        return np.concatenate([np.zeros(6), jv])
 
     def observe(self) -> np.ndarray:
         m = self.measure()

@@ -45,7 +45,8 @@ class GetupTask(PolicyTask):
     record_keys: ClassVar[frozenset[str]] = frozenset({
         "h", "theta_x", "theta_z", "target_h", "target_theta_x", "target_theta_z", "target_h_end",
         "link_ang_vel", "joint_rotations", "neutral_rotations", "naturalness"})
-    action_inputs: ClassVar[frozenset[str]] = frozenset({"condition"})
+    #: the C-VAE's condition (003 §3.4); a feed-forward's phase on the episode's clip (action=ffc_fbc, ours)
+    action_inputs: ClassVar[frozenset[str]] = frozenset({"condition", "phase"})
     curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"terrain_level"})
     #: one deterministic episode, no periodic evaluation, no Table 1 evaluation (a benchmark's)
     cheap_evaluation: ClassVar[dict[str, str]] = {"filmstrip_frames": "0", "eval_episodes": "1",
@@ -62,6 +63,15 @@ class GetupTask(PolicyTask):
 
         from jt_tasks.getup.terrain import REGIONS
 
+        action = group_of(cfg, "action")
+        if action is not None and str(action.get("name", "")) == "ffc_fbc":  # the feed-forward follows each curve's clip
+            from jt_tasks.getup.curves import REFERENCE
+
+            curves = list(group_of(cfg, "task").get("curves") or [])
+            authored = [c for c in curves if c not in REFERENCE]
+            if authored:
+                raise JtError(f"task.curves={curves}: action=ffc_fbc puts each curve's clip pose under the policy, and "
+                              f"{', '.join(authored)} has no clip; use the reference curves ({', '.join(REFERENCE)})")
         node = group_of(cfg, "curriculum")
         if node is not None and str(node.get("name", "")) == "terrain":
             regions = list(node.get("regions") or [])
