@@ -95,3 +95,33 @@ def test_a_bad_output_scale_is_one_line():
     with pytest.raises(JtError, match="output_scale") as e:
         FFCFBCActionSpace({"clip": "walk", "output_scale": "joint"})
     assert "\n" not in str(e.value)
+
+
+def test_use_clip_switches_the_reference_and_keeps_each_track():
+    """A task whose episodes follow different clips (task=getup) swaps the reference; switching
+    back gives the first clip's targets again, bit for bit."""
+    from toolkit.motion import load_clip
+    from jt_actions.ffc_fbc import resolve_clip
+
+    space = FFCFBCActionSpace({"clip": "walk", "clip_to_limits": False})
+    walk = space.reference(0.3).copy()
+    getup = load_clip(resolve_clip("getup_facedown"))
+    space.use_clip(getup, name="getup_facedown")
+    assert space.clip is getup
+    first = space.reference(0.0)
+    np.testing.assert_allclose(first, HUMANOID.joints_to_dofs(getup.joints[0]), atol=1e-9)
+    assert np.abs(space.reference(0.3) - walk).max() > 0.1
+    plain = space.reference(0.5).copy()
+    space.use_clip(getup.mirror())  # the mirrored clip: left and right swapped
+    assert np.abs(space.reference(0.5) - plain).max() > 0.1
+    space.use_clip(space._tracks[next(iter(space._tracks))][0])  # the walk, kept from __init__
+    np.testing.assert_array_equal(space.reference(0.3), walk)
+
+
+def test_use_clip_of_another_skeleton_is_one_line():
+    from toolkit.motion import load_clip
+    from jt_actions.ffc_fbc import resolve_clip
+
+    space = FFCFBCActionSpace({"clip": "walk"})
+    with pytest.raises(JtError, match="laikago"):
+        space.use_clip(load_clip(resolve_clip("laikago_walk")), name="laikago_walk")
