@@ -210,6 +210,58 @@ def study_cmd(ctx: typer.Context, task: Optional[str] = typer.Argument(None, hel
     main_fn(list(ctx.args))
 
 
+@app.command("play")
+def play_cmd(
+    ref: Optional[str] = typer.Argument(None, metavar="[NAME|RUN_ID|PATH]",
+                                        help="A shipped skill's name, a run id, a run's folder or its ppo.h5; none: list the skills."),
+    out: Optional[str] = typer.Option(None, "--out", help="Folder for NAME.gif (and NAME.mp4 with imageio-ffmpeg); "
+                                                          "default ./play."),
+    seconds: Optional[float] = typer.Option(None, "--seconds", help="End the episode after S simulated seconds."),
+    seed: Optional[int] = typer.Option(None, "--seed", help="The environment's seed (default: the skill's / run's)."),
+    start: Optional[str] = typer.Option(None, "--start", help="Where the episode starts, for tasks that offer a choice (a phase...)."),
+    gui: bool = typer.Option(False, "--gui", help="Show PyBullet's window (where a display exists), at real time."),
+    store: Optional[str] = typer.Option(None, "--store", help="The store a RUN_ID is looked up in (default: $JT_STORE or ./artifacts)."),
+    width: int = typer.Option(320, "--width", help="Frame width, px (>= 320)."),
+    height: int = typer.Option(240, "--height", help="Frame height, px (>= 240)."),
+    ship: Optional[str] = typer.Option(None, "--ship", metavar="RUN_ID",
+                                       help="Make the skill NAME from this run (slim policy, prior, manifest), in --out "
+                                            "if given, else in its task's skills package."),
+    description: str = typer.Option("", "--description", help="With --ship: the skill's one-line description."),
+) -> None:
+    """Replay a trained skill headless: jt play lists the shipped ones, jt play NAME writes its GIF."""
+    import time
+
+    t0 = time.perf_counter()
+    from toolkit import skills
+    from toolkit.errors import JtError
+
+    if ref is None and ship is None:
+        typer.echo("jt play NAME: replay a shipped skill (jt play RUN_ID | FOLDER | ppo.h5: a trained run)")
+        for line in skills.listing() or ["(no skills shipped)"]:
+            typer.echo(f"  {line}")
+        return
+    from toolkit.quiet import preload_quietly
+
+    preload_quietly()  # no native banner on the terminal
+    from toolkit import play
+
+    if ship is not None:
+        if not ref:
+            raise JtError("--ship RUN_ID NAME: give the skill's name after the run id")
+        skill = play.ship(ship, ref, store, out, description)
+        typer.echo(f"skill {skill.name} (task={skill.task}) in {skill.folder}: {skills.measure_text(skill.measure)}")
+        typer.echo(f"  jt play {skill.name}" if out is None else f"  jt play {skill.folder}")
+        return
+    play.check_options(width, height, seconds)
+    target = play.target_of(ref, store)
+    done = play.replay(target, out or play.DEFAULT_OUT, seconds, seed, start, gui, width, height)
+    typer.echo(f"{target.label} (task={target.task_name}): {done.line}")
+    files = ", ".join(str(f) for f in done.files) or "no frames"
+    typer.echo(f"  {files} ({done.size[0]}x{done.size[1]}, {done.frames} frames) in {time.perf_counter() - t0:.1f} s")
+    for note in done.notes:
+        typer.echo(f"  {note}")
+
+
 def _store_arg(overrides: Optional[List[str]]) -> Optional[str]:
     from toolkit.errors import JtError
 

@@ -95,6 +95,20 @@ def save_animation(frames: Sequence[np.ndarray], path: str | Path, fps: float = 
     return path
 
 
+_WINDOW = {"on": False}
+
+
+def request_window(on: bool = True) -> None:
+    """Ask the simulators created from now on, in this process, to show their world in a window
+    (``jt play --gui``); a simulator that has none renders headless as always."""
+    _WINDOW["on"] = bool(on)
+
+
+def window_requested() -> bool:
+    """Whether ``request_window`` asked for a window (a simulator reads it when it connects)."""
+    return _WINDOW["on"]
+
+
 def pick(frames: Sequence[Any], n: int) -> list[Any]:
     """``n`` evenly spaced items of ``frames`` (all of them if there are fewer)."""
     if len(frames) <= n:

@@ -21,6 +21,10 @@ _CHECKER_REASONS = {1: "NaN state", 4: "non-finite SPD torques (NaN or exploding
 
 def unavailable(sim: Any) -> str:
     """Why ``sim`` (a ``BulletSimulator``) cannot step through the compiled loop; "" if it can."""
+    from toolkit.render import window_requested
+
+    if window_requested():  # a GUI client (jt play --gui) steps through PyBullet's own API
+        return "a window was asked for (the compiled loop drives DIRECT clients)"
     be = sim.backend
     servo = getattr(be, "method", None) == "servo"  # motors armed once per control step, no kernel
     if sim.steps_itself and not servo:

@@ -19,7 +19,12 @@ def render_frame(client: int, target: Sequence[float], width: int = 320, height:
     ``body``, ``(frame, mask)``: the pixels that show that body, ``(height, width)`` bool."""
     import pybullet as p
 
+    from toolkit.render import window_requested
+
     cam = camera or Camera()
+    if window_requested():  # jt play --gui: the window's camera follows as the frames' does
+        p.resetDebugVisualizerCamera(cam.distance, cam.yaw, cam.pitch, list(map(float, target)),
+                                     physicsClientId=client)
     view = p.computeViewMatrixFromYawPitchRoll(
         cameraTargetPosition=list(map(float, target)), distance=cam.distance, yaw=cam.yaw,
         pitch=cam.pitch, roll=0.0, upAxisIndex=cam.up_axis, physicsClientId=client)

@@ -15,7 +15,8 @@ Z_TO_Y = (-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))  #: quaternion x,y,z,w turn
 
 def connect(dt: float, gravity: float = 9.8, ground: bool = True, friction: float = 0.9,
             solver_iterations: int = 0) -> tuple[int, int]:
-    """A new DIRECT client with a fixed time step, y-up gravity and (optionally) a ground.
+    """A new DIRECT client (a GUI one when ``toolkit.render.request_window`` asked for a window)
+    with a fixed time step, y-up gravity and (optionally) a ground.
 
     Args:
         dt: simulation time step in seconds (``setTimeStep``).
@@ -30,7 +31,9 @@ def connect(dt: float, gravity: float = 9.8, ground: bool = True, friction: floa
     import pybullet as pb
     import pybullet_data
 
-    client = pb.connect(pb.DIRECT)
+    from toolkit.render import window_requested
+
+    client = _window() if window_requested() else pb.connect(pb.DIRECT)
     kw = {"physicsClientId": client}
     pb.setAdditionalSearchPath(pybullet_data.getDataPath(), **kw)
     pb.setGravity(0.0, -float(gravity), 0.0, **kw)
@@ -44,6 +47,24 @@ def connect(dt: float, gravity: float = 9.8, ground: bool = True, friction: floa
                                 useMaximalCoordinates=True, **kw)
         pb.changeDynamics(ground_id, -1, lateralFriction=float(friction), **kw)
     return client, ground_id
+
+
+def _window() -> int:
+    """A GUI client (``toolkit.render.request_window``: ``jt play --gui``), y up as jt's world;
+    one ``JtError`` line when PyBullet cannot open one."""
+    import pybullet as pb
+
+    from toolkit.errors import JtError
+
+    try:
+        client = pb.connect(pb.GUI)
+    except pb.error as e:  # e.g. a GUI already open in this process
+        raise JtError(f"--gui: PyBullet cannot open a window ({e}); replay without --gui") from None
+    if client < 0:
+        raise JtError("--gui: PyBullet cannot open a window here (no OpenGL display?); replay without --gui")
+    pb.configureDebugVisualizer(pb.COV_ENABLE_Y_AXIS_UP, 1, physicsClientId=client)
+    pb.configureDebugVisualizer(pb.COV_ENABLE_GUI, 0, physicsClientId=client)
+    return client
 
 
 def set_friction(client: int, body: int, friction: float) -> None:

@@ -100,6 +100,9 @@ class Task(Plugin, abc.ABC):
             its torques inside the simulator's step (``SPDBackend.steps_itself``). False by default.
         studies: the analysis tools it ships, ``{tool: "module:main"}``, run as ``jt study
             <task> <tool> ...`` (``toolkit.study``); empty by default.
+        skills: the package holding its shipped trained skills, one sub-folder each with a
+            ``manifest.yaml`` (``"jt_tasks.jumping.skills"``; ``jt play``, ``toolkit.skills``);
+            "" (none) by default.
 
     Args:
         cfg: the whole composed run config (``cfg.task`` is this task's group).
@@ -114,6 +117,7 @@ class Task(Plugin, abc.ABC):
     curriculum_attrs: ClassVar[Optional[frozenset[str]]] = None
     needs_spd_torques: ClassVar[bool] = False
     studies: ClassVar[dict[str, str]] = {}
+    skills: ClassVar[str] = ""
 
     def __init__(self, cfg: Any) -> None:
         self.cfg = cfg

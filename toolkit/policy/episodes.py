@@ -72,7 +72,8 @@ class Rollout:
 
 
 def rollout(env: Any, model: Any, record: Optional[Callable[[Any], dict]] = None, frames: int = 0,
-            width: int = 160, height: int = 120, options: Optional[dict] = None) -> Rollout:
+            width: int = 160, height: int = 120, options: Optional[dict] = None,
+            max_steps: Optional[int] = None) -> Rollout:
     """One deterministic episode (the policy's mean action) from ``env.reset(seed=0, options)``.
 
     A safe point comes first (``toolkit.execution.stopping.check``): a stop asked for between
@@ -87,6 +88,8 @@ def rollout(env: Any, model: Any, record: Optional[Callable[[Any], dict]] = None
         frames: render every recorded state when > 0 (``frames`` of them go to a filmstrip).
         width, height: frame size (px).
         options: the reset options (a start time, a start phase, a curve ...).
+        max_steps: stop after this many control steps even if the episode goes on (``jt play
+            --seconds``); None: until it terminates or is truncated.
 
     Returns:
         The ``Rollout``: ``return_``, ``info``, ``steps``, ``frames`` and, per recorded name, an
@@ -107,7 +110,7 @@ def rollout(env: Any, model: Any, record: Optional[Callable[[Any], dict]] = None
             imgs.append(env.render_frame(width, height))
 
     snap()
-    while not done:
+    while not done and (max_steps is None or steps < max_steps):
         obs, r, te, tr, info = env.step(model.act(obs).astype(np.float32))
         ret += r
         steps += 1

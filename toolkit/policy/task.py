@@ -13,6 +13,9 @@ training curves. A task subclass says only what is its own:
   ``record(env)``: what to log per control step; ``rollout_data(ro, env, spec)``: what
   ``rollout.h5`` holds besides ``time``, ``root`` and ``com``; and ``measure(...)``: the metrics.
   The hooks read the deterministic episode as a ``policy.episodes.Rollout`` (``ro``).
+* for ``jt play`` (``toolkit.play``): ``play_summary(env, ro)`` (what a replay reached, the
+  measure a shipped skill documents, and its line), ``play_options(env, start)`` (``--start``)
+  and ``replay_attrs(env_attrs, metrics)`` (the env attributes of a run's replay).
 
 What the hooks of every task share is in ``toolkit.policy`` too: ``sample_budget(ctx)`` (the
 evaluation's PPO budget, for progress fractions), ``episodes.rollout`` / ``episodes.opened_env``
@@ -102,10 +105,13 @@ def trained_policy(cfg: Any, task: str) -> Optional[Path]:
     path = resolve(ref, artifact=tr.CHECKPOINT, store=None if store is None else str(store),
                    what="task.evaluate", label="trained policy", hint=f"train one with: jt run task={task}").path
     try:  # read now, before a run opens: a file that is no PPO checkpoint is one line
-        load_attrs(path)
+        attrs = load_attrs(path)
     except (OSError, ValueError, KeyError) as e:
         raise JtError(f"task.evaluate={ref}: {path} is not a jt PPO checkpoint "
                       f"({str(e).splitlines()[0][:160]}); train one with: jt run task={task}") from None
+    if attrs.get("slim"):  # a shipped skill's policy: no training state to resume from
+        raise JtError(f"task.evaluate={ref}: {path} is a slim policy (a shipped skill's: no value network or "
+                      f"training state); replay it with: jt play {ref}")
     return path
 
 
@@ -204,6 +210,32 @@ class PolicyTask(Task):
         """The evaluation's PPO budget: ``agent.total_samples`` of the ``agent`` group with the
         evaluation's seed (what the progress fractions of the training hooks divide by)."""
         return int(tr.agent_config(group_of(self.cfg, "agent"), ctx.seed).total_samples)
+
+    # ------------------------------------------------------------------ jt play: a trained policy replayed
+    def play_options(self, env: Any, start: Optional[str] = None) -> Optional[dict]:
+        """Reset options of a replay (``jt play``): the final rollout's (``final_options``). ``start``
+        is ``--start X``; a task whose episodes can start elsewhere (a phase, a time) reads it
+        here, the others refuse it in one line."""
+        if start is not None:
+            from toolkit.errors import JtError
+
+            raise JtError(f"--start={start}: task={type(self).name or self.Config().name} replays its one "
+                          "start (its final rollout's); leave --start out")
+        return self.final_options(env)
+
+    def replay_attrs(self, env_attrs: dict[str, Any], metrics: dict[str, float]) -> dict[str, Any]:
+        """Environment attributes a replay of a trained run sets (``jt play RUN``): the checkpoint's
+        ``env_attrs`` (what training set last); ``metrics`` are the run's (empty when unknown), for
+        a task whose final rollout set others."""
+        return dict(env_attrs)
+
+    def play_summary(self, env: Any, ro: Rollout) -> tuple[dict[str, Any], str]:
+        """What a replay reached, ``(measure, line)``: the measure a shipped skill documents
+        (plain numbers, bools, strings) and the line ``jt play`` prints. Default: the return,
+        the control steps and the simulated seconds."""
+        seconds = float(ro.time[-1] - ro.time[0]) if "time" in ro.series else ro.steps / float(env.control_hz)
+        measure = {"return": round(float(ro.return_), 4), "steps": int(ro.steps), "seconds": round(seconds, 3)}
+        return measure, f"return {ro.return_:.3f}, {ro.steps} control steps, {seconds:.2f} s"
 
     # ------------------------------------------------------------------ shared wiring
     @property

@@ -62,6 +62,8 @@ class JumpTask(PolicyTask):
     curriculum_attrs: ClassVar[frozenset[str]] = frozenset({"bar_height", "control_hz", "c_offset"})
     #: ``jt study highjump TOOL`` (and obstacle, longjump): the analysis tools (``jt_tasks.jumping.analysis``)
     studies: ClassVar[dict[str, str]] = {"curves": "jt_tasks.jumping.analysis.curves:main"}
+    #: ``jt play NAME``: the jumps' shipped trained skills, a folder each (``fosbury``: 1.00 m)
+    skills: ClassVar[str] = "jt_tasks.jumping.skills"
 
     @classmethod
     def check_run(cls, cfg: Any) -> None:
@@ -277,6 +279,38 @@ class JumpTask(PolicyTask):
         from jt_tasks.jumping.gallery import PEAK
 
         return [PEAK] if (Path(workdir) / PEAK).is_file() else []
+
+    # ------------------------------------------------------------------ jt play
+    def _z_names(self) -> tuple[str, str, str]:
+        """The curriculum's attribute, what it measures, and its measure's key."""
+        if self.kind == "highjump":
+            return "bar_height", "the bar at {z:.2f} m", "bar_m"
+        return "obstacle_width", "the obstacle {z:.2f} m wide", "obstacle_width_m"
+
+    def replay_attrs(self, env_attrs: dict[str, Any], metrics: dict[str, float]) -> dict[str, Any]:
+        """The checkpoint's attributes, with the bar (width) the final rollout reached when the run
+        recorded it: ``task.final_fallback`` may have jumped one Δz below the curriculum's last."""
+        out = dict(env_attrs)
+        attr = self._z_names()[0]
+        z = metrics.get("bar_height_reached")
+        if z is not None and math.isfinite(float(z)) and attr in out:
+            out[attr] = float(z)
+        return out
+
+    def play_summary(self, env: Any, ro: Rollout) -> tuple[dict[str, Any], str]:
+        """Cleared or not, at which bar (width), and the strategy feature angle (rad) at the
+        crossing; ``{"cleared", "bar_m" | "obstacle_width_m", "strategy_angle_rad"}``."""
+        _, tail = super().play_summary(env, ro)
+        _, what, key = self._z_names()
+        z, angle = float(env.difficulty), float(env.tracker.stage1())
+        cleared = bool(ro.info.get("success", 0.0))
+        head = f"cleared {what.format(z=z)}" if cleared else \
+            f"did not clear {what.format(z=z)} ({ro.info.get('reason') or 'the episode had not ended'})"
+        feature = f"strategy feature angle {angle:.3f} rad" if math.isfinite(angle) else \
+            "no strategy feature (never crossed the plane)"
+        measure = {"cleared": cleared, key: round(z, 4),
+                   "strategy_angle_rad": round(angle, 3) if math.isfinite(angle) else None}
+        return measure, f"{head}; {feature} ({tail})"
 
     # ------------------------------------------------------------------ the search's summary
     def strategies(self, items: list[dict]) -> list[dict]:

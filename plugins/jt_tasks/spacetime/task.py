@@ -114,6 +114,21 @@ class SpacetimeTask(PolicyTask):
     def final_options(self, env: Any) -> Optional[dict]:
         return {"phase": float(self.params.eval_phase), "evaluate": True}
 
+    def play_options(self, env: Any, start: Optional[str] = None) -> Optional[dict]:
+        """``jt play --start X``: the clip phase in [0, 1] the replay starts at (default ``task.eval_phase``)."""
+        options = dict(self.final_options(env) or {})
+        if start is not None:
+            try:
+                phase = float(start)
+            except ValueError:
+                phase = math.nan
+            if not 0.0 <= phase <= 1.0:
+                from toolkit.errors import JtError
+
+                raise JtError(f"--start={start}: task=spacetime starts at a clip phase in [0, 1]")
+            options["phase"] = phase
+        return options
+
     def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
         from jt_tasks.spacetime.artifacts import com_height_data
 

@@ -146,3 +146,12 @@ def test_the_laptop_preset_is_the_setting_measured_to_reach_20_s():
     assert np.allclose(wb[:3], 0.2)
     _, run = task("experiment=laptop", "task.clip=run")
     assert run.task.clip == "run" and run.agent.total_samples == cfg.agent.total_samples
+
+
+def test_jt_play_start_is_the_clip_phase():
+    t, _ = task("task.eval_phase=0.1")
+    assert t.play_options(None) == {"phase": 0.1, "evaluate": True}
+    assert t.play_options(None, "0.25") == {"phase": 0.25, "evaluate": True}
+    for bad in ("1.5", "x", "nan"):
+        with pytest.raises(JtError, match=r"--start=.*: task=spacetime starts at a clip phase in \[0, 1\]"):
+            t.play_options(None, bad)
