@@ -21,6 +21,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests.conftest import jt_env, store_query
@@ -465,3 +466,29 @@ def test_ctrl_c_asks_for_a_safe_point_and_a_second_one_stops_at_once():
             assert stopping.requested() is None
     finally:
         signal.signal(signal.SIGINT, old)
+
+
+@pytest.mark.slow
+def test_a_high_jump_search_stopped_mid_evaluation_resumes_bit_for_bit(template_db, tmp_path):
+    """A real policy search (PPO evaluations, P-VAE-free smoke settings), SIGTERM in its second
+    evaluation's training, resumed: every feature equals the uninterrupted run's exactly (issue 55;
+    it differed in the 7th digit while bar contacts reordered PyBullet's contact pairs)."""
+    from toolkit.store import h5
+
+    args = ["run", "task=highjump", "search=bds", "experiment=smoke", "search.budget=2",
+            "agent.total_samples=2048", "agent.checkpoint_every=3", "seed=0"]
+    whole = _new_store(template_db, tmp_path / "whole")
+    p = _jt(tmp_path, *args, f"store={whole}")
+    assert p.wait(timeout=600) == 0, p.communicate()[1]
+    cut = _new_store(template_db, tmp_path / "cut")
+    p = _jt(tmp_path, *args, f"store={cut}")
+    rid = _wait("the run's row", lambda: _outer_ids(cut), every=0.05)[0]
+    _wait("the second evaluation", lambda: (cut / "work" / rid / "eval_0001" / "ppo.h5").is_file(), timeout=600)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 130 and _status(cut, rid) == "KILLED", err
+    p = _jt(tmp_path, "run", f"resume={rid}", f"store={cut}")
+    assert p.wait(timeout=600) == 0, p.communicate()[1]
+    feats = [h5.read(next((s / "work").glob("*/search_history.h5")))["features"] for s in (whole, cut)]
+    assert feats[0].shape == (2, 1)
+    assert np.array_equal(feats[0], feats[1], equal_nan=True), feats
