@@ -13,6 +13,8 @@ not terminated early, from a fallen start (clip or rag-doll), whose neck height 
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 from typing import Any, ClassVar, Optional
 
@@ -198,6 +200,40 @@ class GetupTask(PolicyTask):
         falls = [{"kind": "fallen", "fallen": i} for i in range(len(env.spec_.fallen))]
         pool = [o for pair in zip(others + [None] * len(falls), falls + [None] * len(others)) for o in pair if o]
         return (opts + pool * n)[:n] if pool else opts * n
+
+    def play_options(self, env: Any, start: Optional[str] = None) -> Optional[dict]:
+        """``jt play --start``: a curve's clip start (``facedown``, ``faceup_mirror`` ...) or
+        ``drop`` (the first rag-doll state); default the final rollout's (``task.eval_curve``)."""
+        if start is None:
+            return self.final_options(env)
+        from toolkit.errors import JtError
+
+        names = [c.name for c in env.curves if c.clip]
+        if start == "drop":
+            if not env.spec_.fallen:
+                raise JtError("--start=drop: this configuration makes no rag-doll states (task.n_fallen=0)")
+            return {"kind": "fallen", "fallen": 0}
+        if start not in names:
+            raise JtError(f"--start={start}: one of {', '.join(names)} (a clip's first pose) or drop (a rag-doll state)")
+        return {"kind": "clip", "curve": start}
+
+    def play_summary(self, env: Any, ro: Rollout) -> tuple[dict[str, Any], str]:
+        """Got up (the standing height reached) and when, stood to the end (003 §6.3's rule as the
+        env applies it) or why the episode ended; ``{"got_up", "stood", "time_to_rise_s", "peak_h_m"}``."""
+        _, tail = super().play_summary(env, ro)
+        info = ro.info
+        got_up, stood = bool(info.get("got_up", 0.0)), bool(info.get("success", 0.0))
+        rise = float(info.get("time_to_rise", math.nan))
+        peak = max((row["h"] for row in env.log), default=math.nan)
+        if stood:
+            head = f"got up in {rise:.2f} s and stood to the end"
+        elif got_up:
+            head = f"got up in {rise:.2f} s, then fell ({info.get('reason', '')})"
+        else:
+            head = f"did not get up: neck at most {peak:.2f} m ({info.get('reason', '')})"
+        measure = {"got_up": got_up, "stood": stood, "time_to_rise_s": round(rise, 3) if got_up else None,
+                   "peak_h_m": round(float(peak), 3)}
+        return measure, f"{head} ({tail})"
 
     def record(self, env: Any) -> dict[str, Any]:
         out = super().record(env)
