@@ -118,6 +118,10 @@ class GetupConfig(PolicyConfig):
     """Default of the searched point: every curve's T times this (003 §4.3)."""
     ffc_lead: int = 0
     """With ``action=ffc_fbc`` (a feed-forward under the policy, ours, not 003: docs/getup.md): control steps the clip pose of the feed-forward target leads the curve's clock (002 §4.2: 0; spacetime's experiment=laptop: 1)."""
+    ffc_hold: str = "clip"
+    """With ``action=ffc_fbc``, what the feed-forward holds once the clip has ended: clip (its last frame) or stance (it moves to the standing pose of ``task.stand_pose`` over ``ffc_blend`` s; ours: held by PD the clip's last frame falls in ~1.3 s, docs/getup.md)."""
+    ffc_blend: float = 0.5
+    """S over which the feed-forward moves from the clip's last frame to the stance (``ffc_hold=stance``)."""
     ffc_velocity: bool = False
     """With ``action=ffc_fbc``: the clip's joint velocities at the feed-forward's time as the PD target velocities (ours, as spacetime's experiment=laptop; false: zero, 002 §4.2)."""
 
@@ -206,6 +210,8 @@ class GetupConfig(PolicyConfig):
                 self.eval_locations, "an integer >= 1 (task.eval_regions=[] skips the Table 1 evaluation)")
         require(self.drop_hz is None or (finite(self.drop_hz) and self.drop_hz >= 30.0), "task.drop_hz", self.drop_hz,
                 "null or >= 30 Hz")
+        require(self.ffc_hold in ("clip", "stance"), "task.ffc_hold", self.ffc_hold, "clip or stance")
+        require(finite(self.ffc_blend) and self.ffc_blend > 0, "task.ffc_blend", self.ffc_blend, "must be > 0 s")
         require(isinstance(self.ffc_lead, int) and self.ffc_lead >= 0, "task.ffc_lead", self.ffc_lead,
                 "control steps, an integer >= 0")
         require(self.heightmap_n >= 1, "task.heightmap_n", self.heightmap_n, "must be >= 1")

@@ -159,7 +159,10 @@ class GetupEnv(CharacterEnv):
         if hasattr(self.action_space_, "use_clip"):  # a feed-forward under the policy: this curve's clip (ours)
             from jt_tasks.getup.curves import load_getup_clip
 
-            self.action_space_.use_clip(load_getup_clip(c.clip, c.mirrored), name=c.clip)
+            self._ff_clip = load_getup_clip(c.clip, c.mirrored)
+            self.action_space_.use_clip(self._ff_clip, name=c.clip)
+            # ffc_hold=stance: the move to the stance starts as the clip ends (a standing start: done)
+            self._stance_t0 = c.duration - (float(self.spec_.ffc_blend) if kind == "standing" else 0.0)
         self.curve_index, self.curve, self.start_kind = curve, c, kind
         # the curve's clock at the start: standing s = 1; a clip start inside the clip (rsi) its time
         self.t_offset = c.duration if kind == "standing" else (float(at) if kind == "clip" else 0.0)
@@ -301,6 +304,19 @@ class GetupEnv(CharacterEnv):
             self._ahead.flags.writeable = False
         return self._ahead
 
+    def _stance_clip(self, clip: Any) -> Any:
+        """A two-frame clip from ``clip``'s last frame to the standing pose in ``ffc_blend`` s (memoised)."""
+        import dataclasses as dc
+
+        memo = self.__dict__.setdefault("_stance_clips", {})
+        if id(clip) not in memo:
+            q = self.stand_state[0]
+            memo[id(clip)] = dc.replace(
+                clip, name=f"{clip.name}_to_stance", times=np.array([0.0, float(self.spec_.ffc_blend)]),
+                root_pos=np.stack([clip.root_pos[-1], q[:3]]), root_rot=np.stack([clip.root_rot[-1], q[3:7]]),
+                joints=np.stack([clip.joints[-1], q[7:]]), loop=False, source="")
+        return memo[id(clip)]
+
     def clip_phase(self, t: float) -> float:
         """The episode clip's phase ``[0, 1]`` at curve time ``t`` s (the clip's time scaled to the
         curve's ``T``; 1, its last frame, held through the standing phase)."""
@@ -315,7 +331,13 @@ class GetupEnv(CharacterEnv):
         if hasattr(self.action_space_, "set_condition"):  # C-VAE: c = the curves now (003 §3.4)
             self.action_space_.set_condition(self.targets(self.t))
         if hasattr(self.action_space_, "set_phase"):  # feed-forward: the clip's pose at the curve's clock (ours)
-            self.action_space_.set_phase(self.clip_phase(self.feedforward_time()))
+            t = self.feedforward_time()
+            if self.spec_.ffc_hold == "stance" and t >= self._stance_t0 and t >= self.curve.duration:
+                self.action_space_.use_clip(self._stance_clip(self._ff_clip))  # then on to the stance
+                self.action_space_.set_phase(min((t - self._stance_t0) / float(self.spec_.ffc_blend), 1.0))
+            else:
+                self.action_space_.use_clip(self._ff_clip)
+                self.action_space_.set_phase(self.clip_phase(t))
         # the links now, as the observation of this state read them (the same state: no new query)
         self._prev_links = self._lv[:2] if self._lv is not None else self.sim.link_states()
         self._lv = None
