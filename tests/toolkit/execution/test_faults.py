@@ -489,6 +489,11 @@ def test_a_high_jump_search_stopped_mid_evaluation_resumes_bit_for_bit(template_
     assert p.returncode == 130 and _status(cut, rid) == "KILLED", err
     p = _jt(tmp_path, "run", f"resume={rid}", f"store={cut}")
     assert p.wait(timeout=600) == 0, p.communicate()[1]
-    feats = [h5.read(next((s / "work").glob("*/search_history.h5")))["features"] for s in (whole, cut)]
-    assert feats[0].shape == (2, 1)
-    assert np.array_equal(feats[0], feats[1], equal_nan=True), feats
+    a, b = (h5.read(next((s / "work").glob("*/search_history.h5"))) for s in (whole, cut))
+    assert a["features"].shape == (2, 1)
+    for key in ("x", "features", "objectives"):
+        assert np.array_equal(a[key], b[key], equal_nan=True), key
+    timing = [k for k in a["metrics"] if k.endswith("_s") or "per_s" in k or "wall" in k]  # wall time
+    assert sorted(timing) == ["samples_per_s", "train_wall_s"] and len(a["metrics"]) > 15
+    for key in sorted(set(a["metrics"]) - set(timing)):  # every other metric, ==
+        assert np.array_equal(a["metrics"][key], b["metrics"][key], equal_nan=True), key
