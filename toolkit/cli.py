@@ -148,24 +148,36 @@ def show_cmd(
 def ui_cmd(
     overrides: Optional[List[str]] = typer.Argument(None, help="store=PATH or store=http://host:port"),
     port: int = typer.Option(5000, "--port"),
-    open_browser: bool = typer.Option(False, "--open", help="Open a server store's URL in a browser."),
+    open_browser: bool = typer.Option(False, "--open", help="Open the first URL printed in a browser."),
 ) -> None:
-    """Serve the MLflow UI for the store on 127.0.0.1 (a server store: print its URL)."""
+    """Serve the MLflow UI for the store on 127.0.0.1 and print where each task's runs are, in
+    MLflow's "Model training" view with the task's key metrics as columns (a server store: print
+    its URL)."""
     from toolkit.store.tracking import is_server_uri, store_root
 
     root = store_root(_store_arg(overrides))
     if is_server_uri(root):  # the tracking server serves its own UI: nothing to start here
-        typer.echo(f"MLflow UI: {root}  (served by the tracking server)")
+        target = f"{root}/#/experiments?workflowType=machine_learning"
+        typer.echo(f"MLflow UI: {target}  (served by the tracking server)")
         if open_browser:
             import webbrowser
 
-            webbrowser.open(str(root))
+            webbrowser.open(target)
         return
-    from toolkit.store.ui import check, serve, url
+    from toolkit.store import ui
 
-    check(root, port)  # a busy port, a bind beyond loopback, a bad store: one line, no URL printed
-    typer.echo(f"MLflow UI for {root}: {url(port)}  (Ctrl-C to stop)")
-    serve(root, port)
+    ui.check(root, port)  # a busy port, a bind beyond loopback, a bad store: one line, no URL printed
+    ui.ensure_store(root)
+    experiments = ui.prepare(root)  # jt's experiments tagged for the UI, the newest run's first
+    rows = [(name, ui.url(port, eid, view)) for eid, name, view in experiments]
+    rows.append(("all experiments", ui.url(port)))
+    width = max(len(r[0]) for r in rows)
+    typer.echo(f"MLflow UI for {root} (Ctrl-C to stop):")
+    for name, link in rows:
+        typer.echo(f"  {name:<{width}}  {link}")
+    if open_browser:
+        ui.open_when_up(rows[0][1], port)
+    ui.serve(root, port)
 
 
 @app.command("plugins")

@@ -168,6 +168,9 @@ def _preset(parsed: Sequence[Any]) -> list[str]:
 def compose(overrides: Sequence[str] = (), run_checks: bool = True) -> Any:
     """Compose ``conf/config.yaml`` with ``overrides`` (Hydra syntax), checked and typed.
 
+    ``task.evaluate=NAME`` of a shipped skill puts the skill's own overrides under these
+    (``toolkit.skills.evaluate_overrides``); an error then says which of these replaced the skill's.
+
     Hydra composes the defaults lists: the task's own group choices (``override /spd: df`` in
     ``conf/task/<task>.yaml``), then the experiment's per-task preset ``preset/<experiment>_<task>``
     (which may choose groups too), then the command line, which wins. ``group.key=value``
@@ -184,13 +187,40 @@ def compose(overrides: Sequence[str] = (), run_checks: bool = True) -> Any:
     Raises:
         JtError: one line naming what is wrong and, for choices, the valid ones.
     """
+    from toolkit.skills import evaluate_overrides, replaced_overrides
+
+    given = list(overrides)
+    overrides = evaluate_overrides(given)  # task.evaluate=NAME: a shipped skill's own settings under these
+    if len(overrides) == len(given):
+        return _compose(given, run_checks)
+    try:
+        return _compose(overrides, run_checks)
+    except JtError as e:
+        clash = replaced_overrides(given)
+        if not clash or str(e).startswith("task.evaluate="):  # a line of its own about the skill
+            raise
+        raise JtError(f"{e} (task.evaluate composes the skill's settings under yours: {clash}; leave those out)") from e
+
+
+def compose_skill(skill: Any, *more: str, run_checks: bool = True) -> Any:
+    """The run config a shipped skill's overrides compose (``toolkit.skills.Skill``: its
+    environment's settings), with ``more`` overrides after them; one ``JtError`` line when they
+    compose another task than its manifest says."""
+    cfg = compose([*skill.resolved_overrides(), *more], run_checks)
+    got = str(cfg.task.name)
+    if got != skill.task:
+        raise JtError(f"skill '{skill.name}': its overrides compose task={got}, its manifest says task={skill.task}")
+    return cfg
+
+
+def _compose(overrides: list[str], run_checks: bool) -> Any:
+    """``compose`` of the overrides as they are."""
     from hydra import compose as hydra_compose
     from hydra import initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
     from toolkit.schema import ignored_choice, validate
 
-    overrides = list(overrides)
     parsed = _parse(overrides)
     _check_choices(parsed)
     task = _choice(parsed, "task")

@@ -95,9 +95,9 @@ def _policy_task(name: str, cfg: Any, what: str) -> Any:
 
 def from_skill(skill: Skill) -> Target:
     """The replay of a shipped skill (its overrides composed, its task built)."""
-    from toolkit import skills
+    from toolkit.config import compose_skill
 
-    cfg = skills.compose(skill)
+    cfg = compose_skill(skill)
     task = _policy_task(skill.task, cfg, f"skill '{skill.name}'")
     return Target(label=skill.name, task_name=skill.task, task=task, cfg=cfg, policy=skill.policy,
                   point=dict(skill.point), env_attrs=dict(skill.env_attrs), seed=int(skill.seed), skill=skill)

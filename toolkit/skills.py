@@ -27,6 +27,12 @@ slim policy, the prior, the manifest from the run's command, tags and metrics, a
 one replay.
 A skill whose policy no longer fits the environment its overrides build (another observation or
 action size) is refused in one line that names the command retraining it (``check_fits``).
+
+``jt run task.evaluate=NAME`` measures a shipped skill as a run (``toolkit.policy.task``): the
+skill's overrides compose under the command line's (``evaluate_overrides``: the command line wins,
+a group it chooses otherwise drops the skill's keys of that group; ``toolkit.config.compose_skill``
+composes a skill's own), and the run's environment must be the skill's
+(``toolkit.policy.task.check_skill_settings``).
 """
 
 from __future__ import annotations
@@ -83,6 +89,62 @@ class Skill:
         if not any(o.startswith("task=") for o in out):
             out.insert(0, f"task={self.task}")
         return out
+
+
+# ---------------------------------------------------------------------------- task.evaluate=NAME
+_RUN_ID = re.compile(r"^[0-9a-f]{32}$")
+
+
+def is_skill_ref(ref: str) -> bool:
+    """Whether ``ref`` names a shipped skill rather than a run (an MLflow run id) or a path."""
+    from toolkit.store.resolve import is_path
+
+    ref = str(ref or "").strip()
+    return bool(ref) and not _RUN_ID.match(ref) and not is_path(ref)
+
+
+def _key(override: str) -> str:
+    return override.split("=", 1)[0].lstrip("+~").strip()
+
+
+def evaluate_overrides(overrides: Any) -> list[str]:
+    """``overrides`` with a shipped skill's own overrides under them when ``task.evaluate=NAME``
+    names one (``jt run task.evaluate=fosbury`` composes the Fosbury skill's environment): the
+    command line's win, and a group it chooses otherwise (``search=bds``) drops the skill's keys
+    of that group (``search.budget=1``). As given otherwise (an unknown name is the line of
+    ``toolkit.policy.task.trained_skill``, which names the shipped skills)."""
+    overrides = list(overrides)
+    refs = [o.split("=", 1)[1].strip().strip("'\"") for o in overrides if _key(o) == "task.evaluate" and "=" in o]
+    if not refs or not is_skill_ref(refs[-1]):
+        return overrides
+    skill = next((s for s in scan()[0] if s.name == refs[-1]), None)
+    if skill is None:
+        return overrides
+    given = {_key(o): o for o in overrides}
+    theirs = {_key(o): o for o in skill.resolved_overrides()}
+    other = tuple(f"{k}." for k, o in given.items() if "." not in k and theirs.get(k, o) != o)  # another choice
+    own = [o for k, o in theirs.items() if k not in given and not k.startswith(other)]
+    return own + overrides
+
+
+def replaced_overrides(overrides: Any) -> str:
+    """Which of ``overrides`` replace the settings of the skill that their ``task.evaluate=NAME``
+    names (``experiment=smoke replaces the skill's experiment=laptop``), for a message; ``""``
+    when none does."""
+    overrides = list(overrides)
+    refs = [o.split("=", 1)[1].strip().strip("'\"") for o in overrides if _key(o) == "task.evaluate" and "=" in o]
+    skill = next((s for s in scan()[0] if refs and s.name == refs[-1]), None)
+    if skill is None:
+        return ""
+    theirs = {_key(o): o for o in skill.resolved_overrides()}
+    kept = set(evaluate_overrides(overrides)[: -len(overrides)])  # the skill's that stay
+    out = []
+    for o in overrides:
+        k = _key(o)
+        dropped = [t for kk, t in theirs.items() if (kk == k or kk.startswith(f"{k}.")) and t not in kept and t != o]
+        if dropped and k not in ("task.evaluate", "store"):
+            out.append(f"{o} replaces the skill's {' '.join(dropped)}")
+    return "; ".join(out)
 
 
 # ---------------------------------------------------------------------------- discovery
@@ -224,17 +286,6 @@ def write_manifest(skill: Skill) -> Path:
     path = skill.folder / MANIFEST
     path.write_text(head + yaml.safe_dump(data, sort_keys=False, width=120, allow_unicode=True))
     return path
-
-
-def compose(skill: Skill) -> Any:
-    """The run config the skill's overrides compose (its environment's settings)."""
-    from toolkit.config import compose as compose_config
-
-    cfg = compose_config(skill.resolved_overrides())
-    got = str(cfg.task.name)
-    if got != skill.task:
-        raise JtError(f"skill '{skill.name}': its overrides compose task={got}, its manifest says task={skill.task}")
-    return cfg
 
 
 def check_fits(policy: Path, env: Any, skill: Optional[Skill] = None, what: str = "") -> None:

@@ -127,12 +127,15 @@ def evaluation(index: int, parent: str, point: Mapping[str, float], seed: int, m
 def ensure_experiment(store: Any, task: str, task_cls: Any) -> str:
     """Experiment ``task`` (created if missing) with its description and tags; its id.
 
-    ``mlflow.experimentKind = custom_model_development`` makes the UI open it in its "Model
-    training" view (not GenAI's traces), as choosing that view there would.
+    ``mlflow.experimentKind = custom_model_development`` files it as model training (not GenAI),
+    and jt's saved view shows the task's key metrics as the runs table's columns
+    (``toolkit.store.ui.experiment_tags``; ``jt ui`` opens it).
     """
+    from toolkit.store.ui import experiment_tags
+
     summary = ((getattr(task_cls, "__doc__", None) or "").strip().splitlines() or [""])[0]
     return store.describe_experiment(task, experiment(task, summary), {
-        "jt.task": task, "mlflow.experimentKind": "custom_model_development"})
+        "jt.task": task, **experiment_tags(tuple(getattr(task_cls, "key_metrics", ())))})
 
 
 def experiment(task: str, summary: str) -> str:

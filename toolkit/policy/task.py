@@ -79,6 +79,9 @@ def check_policy_fits(cfg: Any, task: str, path: Path) -> None:
     from toolkit.errors import JtError
     from toolkit.rl.checkpoint import load_attrs
 
+    skill = trained_skill(cfg, task)
+    if skill is not None:
+        check_skill_settings(cfg, task, skill)
     attrs = load_attrs(path)
     want = (int(attrs["obs_dim"]), int(attrs["act_dim"]))
     with opened_env(plugins.load("task", task)(cfg).make_env, seed=0) as env:
@@ -96,6 +99,9 @@ def trained_policy(cfg: Any, task: str) -> Optional[Path]:
     ref = str(group_of(group_of(cfg, "task") or {}, "evaluate") or "").strip()
     if not ref:
         return None
+    skill = trained_skill(cfg, task)
+    if skill is not None:
+        return skill.policy
     from toolkit.store.resolve import resolve
 
     from toolkit.errors import JtError
@@ -111,8 +117,81 @@ def trained_policy(cfg: Any, task: str) -> Optional[Path]:
                       f"({str(e).splitlines()[0][:160]}); train one with: jt run task={task}") from None
     if attrs.get("slim"):  # a shipped skill's policy: no training state to resume from
         raise JtError(f"task.evaluate={ref}: {path} is a slim policy (a shipped skill's: no value network or "
-                      f"training state); replay it with: jt play {ref}")
+                      f"training state); measure a shipped skill by its name (task.evaluate=NAME, jt play lists "
+                      f"them) or replay it with: jt play {ref}")
     return path
+
+
+def trained_skill(cfg: Any, task: str = "") -> Any:
+    """The shipped skill (``toolkit.skills.Skill``) that ``task.evaluate`` names, or None when it
+    names a run, a folder, a file or nothing; one ``JtError`` line, naming the shipped skills, for
+    a name that is none of them."""
+    from toolkit import skills
+
+    ref = str(group_of(group_of(cfg, "task") or {}, "evaluate") or "").strip()
+    if not skills.is_skill_ref(ref):
+        return None
+    found, _ = skills.scan()
+    for skill in found:
+        if skill.name == ref:
+            return skill
+    from toolkit.errors import JtError
+
+    shipped = ", ".join(s.name for s in found) or "(none)"
+    train = f"; train one with: jt run task={task}" if task else ""
+    raise JtError(f"task.evaluate={ref}: no shipped skill of that name (shipped: {shipped}; jt play lists them), "
+                  f"and not a run id or a path{train}")
+
+
+def _plain(value: Any) -> Any:
+    """``value`` with arrays, numpy scalars, tuples and dataclasses made plain lists, numbers, dicts."""
+    import numpy as np
+
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (np.ndarray, list, tuple)):
+        return [_plain(v) for v in (value.tolist() if isinstance(value, np.ndarray) else value)]
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def _flat(value: Any, prefix: str = "") -> dict[str, Any]:
+    """An env spec as ``{dotted key: plain value}`` (nested dataclasses and dicts spelled out)."""
+    value = _plain(value)
+    if isinstance(value, dict) and value:
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            out.update(_flat(v, f"{prefix}{k}."))
+        return out
+    return {prefix.rstrip("."): value}
+
+
+def check_skill_settings(cfg: Any, task: str, skill: Any) -> None:
+    """``task.evaluate=NAME``: the run's environment is the shipped skill's, the one its policy was
+    trained in (``env_spec`` at the skill's point, from this run's config and from the skill's
+    overrides); else one ``JtError`` line naming the first settings that differ."""
+    from toolkit import plugins
+    from toolkit.errors import JtError
+
+    if skill.task != task:
+        raise JtError(f"task.evaluate={skill.name}: a skill of task={skill.task}, this run is task={task}; "
+                      f"leave task= out (jt run task.evaluate={skill.name} composes the skill's own settings)")
+    from toolkit.config import compose_skill
+
+    cls = plugins.load("task", task)
+    store = group_of(cfg, "store")  # what the store and task.evaluate put in a spec is the run's on both sides
+    own = compose_skill(skill, *([f"store={store}"] if store else []), f"task.evaluate={skill.name}", run_checks=False)
+    mine = _flat(cls(cfg).env_spec(dict(skill.point)))
+    theirs = _flat(cls(own).env_spec(dict(skill.point)))
+    diff = [k for k in list(theirs) + [k for k in mine if k not in theirs] if mine.get(k) != theirs.get(k)]
+    if diff:
+        shown = ", ".join(f"{k}={mine.get(k)!r} (the skill's {theirs.get(k)!r})" for k in diff[:3])
+        more = f" and {len(diff) - 3} more" if len(diff) > 3 else ""
+        raise JtError(f"task.evaluate={skill.name}: this run's environment is not the skill's (its env spec: "
+                      f"{shown}{more}); "
+                      f"leave out the overrides that change it (jt run task.evaluate={skill.name} composes the "
+                      f"skill's own: {' '.join(skill.overrides)})")
 
 
 @dataclasses.dataclass
@@ -129,8 +208,10 @@ class PolicyConfig:
     """px."""
     evaluate: str = ""
     """A trained policy to measure instead of training one: a run id (its best evaluation), a
-    folder or a ``ppo.h5``. Its policy is rolled out and measured with this run's settings and
-    no sample is collected (jt; e.g. ``003`` Table 1 of a policy trained earlier)."""
+    folder or a ``ppo.h5``, or a shipped skill's name (``jt play`` lists them: its overrides
+    compose under the command line's, its environment attributes are set, and the run's
+    environment must be the skill's). Its policy is rolled out and measured with this run's
+    settings and no sample is collected (jt; e.g. ``003`` Table 1 of a policy trained earlier)."""
 
 
 @dataclasses.dataclass
@@ -268,14 +349,23 @@ class PolicyTask(Task):
         spec = self.env_spec(point)
         hooks = self.training(spec, ctx)
         spec = hooks.spec if hooks.spec is not None else spec
-        trained = tr.train_policy(tr.EnvFactory(self.env_class, spec), group_of(self.cfg, "agent"),
-                                  group_of(self.cfg, "executor"), workdir, ctx.seed, hooks.on_iteration,
-                                  hooks.extra, hooks.should_stop, hooks.warm_start,
-                                  self._adopt_trained(workdir))
+        skill = trained_skill(self.cfg, type(self).name or self.Config().name)
+        attrs: dict[str, Any] = {}
+        if skill is not None:  # task.evaluate=NAME: the skill's slim policy, in the environment it was trained in
+            attrs = dict(skill.env_attrs)
+            self.adopt_attrs(hooks, attrs)
+            trained = tr.adopted(self._adopt_skill(skill, workdir), group_of(self.cfg, "agent"), ctx.seed)
+        else:
+            trained = tr.train_policy(tr.EnvFactory(self.env_class, spec), group_of(self.cfg, "agent"),
+                                      group_of(self.cfg, "executor"), workdir, ctx.seed, hooks.on_iteration,
+                                      hooks.extra, hooks.should_stop, hooks.warm_start,
+                                      self._adopt_trained(workdir))
         model = load_policy(trained.checkpoint)
         outer.report(TRAIN_SHARE, "final rollout")
         with opened_env(self.env_class, spec, seed=ctx.seed) as env:
             self.final_env(env, hooks, trained)
+            for key, value in attrs.items():  # as jt play sets them
+                setattr(env, key, value)
             while True:
                 ro = rollout(env, model, self.record, p.filmstrip_frames, p.filmstrip_width,
                              p.filmstrip_height, self.final_options(env))
@@ -312,6 +402,25 @@ class PolicyTask(Task):
                 shutil.copyfile(src, tmp)
         done = int(load(dst)[0]["counters"]["samples"])
         return lambda c: dataclasses.replace(with_architecture(c, dst), total_samples=done)
+
+    def _adopt_skill(self, skill: Any, workdir: Path) -> Path:
+        """A shipped skill's slim policy copied into ``workdir`` as its ``ppo.h5`` (logged with the
+        run, as a trained run's is; ``jt play RUN`` replays it)."""
+        import shutil
+
+        dst = Path(workdir) / tr.CHECKPOINT
+        if not dst.exists():
+            from toolkit.store.atomic import atomic_write
+
+            with atomic_write(dst) as tmp:
+                shutil.copyfile(skill.policy, tmp)
+        return dst
+
+    def adopt_attrs(self, hooks: Hooks, env_attrs: dict[str, Any]) -> None:
+        """``task.evaluate=NAME``: bring the training hooks' state (a curriculum) to a shipped
+        skill's environment attributes, as if training had ended there; nothing is trained.
+        ``evaluate`` sets the attributes on the final rollout's environment after ``final_env``
+        either way. Default: nothing."""
 
     def extra_artifacts(self, workdir: Path) -> list[str]:
         """Files of the task's own that the evaluation logs besides the shared ones."""

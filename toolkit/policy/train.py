@@ -123,6 +123,20 @@ def train_policy(env_fn: Callable[[int], Any], agent: Any, executor: Any, workdi
     return Trained(result=result, config=cfg, wall_s=time.perf_counter() - t0, checkpoint=path)
 
 
+def adopted(path: Path, agent: Any, seed: int) -> Trained:
+    """A slim policy (a shipped skill's, ``toolkit.rl.checkpoint.slim``) as a training that is over:
+    its model, the samples and iterations it was trained with (its attributes), no per-iteration
+    history, no time spent. Nothing resumes from it (a slim file has no training state)."""
+    from toolkit.rl.checkpoint import load_attrs, load_policy, with_architecture
+    from toolkit.rl.ppo import TrainResult
+
+    attrs = load_attrs(path)
+    result = TrainResult(model=load_policy(path), iterations=max(0, int(attrs.get("iteration", 0))),
+                         samples=max(0, int(attrs.get("samples", 0))), history={}, extra={}, checkpoint_path=Path(path))
+    return Trained(result=result, config=with_architecture(agent_config(agent, seed), path), wall_s=0.0,
+                   checkpoint=Path(path))
+
+
 def pick_frames(frames: list, n: int) -> list:
     """``n`` frames evenly spread over ``frames`` (first and last included)."""
     if not frames or n <= 0:

@@ -212,6 +212,24 @@ class JumpTask(PolicyTask):
         z_min, dz = getattr(p, "z_min", None), getattr(p, "dz", None)
         self._fallback = (float(z_min), float(dz), hooks.state["z_attr"]) if z_min is not None and dz else None
 
+    def adopt_attrs(self, hooks: Any, env_attrs: dict[str, Any]) -> None:
+        """A shipped skill's bar (``task.evaluate=NAME``): the curriculum at the level of that bar,
+        so ``final_env`` sets it (and its control rate and offset) and ``bar_height_trained`` is
+        it; a bar off the curriculum's grid, or a curriculum without levels, is left as it is
+        (``evaluate`` sets the skill's attributes on the environment either way)."""
+        cur, attr = hooks.state["cur"], hooks.state["z_attr"]
+        p, z = getattr(cur, "params", None), env_attrs.get(attr)
+        z_min, dz = getattr(p, "z_min", None), getattr(p, "dz", None)
+        if z is None or z_min is None or not dz or not hasattr(cur, "level"):
+            return
+        level = round((float(z) - float(z_min)) / float(dz))
+        try:
+            cur.load_state({"level": level, "accumulator": 0.0})
+        except (ValueError, KeyError):
+            return
+        if abs(float(cur.env_attrs().get(attr, math.nan)) - float(z)) > 1e-9:
+            cur.load_state({"level": 0, "accumulator": 0.0})
+
     def retry_rollout(self, env: Any, ro: Rollout) -> bool:
         """``task.final_fallback``: one Δz lower when the jump never crossed the plane (not below z_min)."""
         fallback = getattr(self, "_fallback", None)
@@ -245,7 +263,8 @@ class JumpTask(PolicyTask):
         succ = [r for _, _, r in hooks.state["z_hist"] if math.isfinite(r)]
         angle = float(notes["feature_angle"])
         own = {"strategy_angle": angle, "bar_height_reached": float(notes.get("final_z", trained_z)),
-               "bar_height_trained": trained_z, "success_rate": succ[-1] if succ else 0.0,
+               "bar_height_trained": trained_z,
+               "success_rate": succ[-1] if succ else 0.0 if hooks.state["z_hist"] else math.nan,  # nan: no training
                "final_success": float(ro.info.get("success", 0.0))}
         own.update({f"takeoff_{k}": float(v) for k, v in spec.features.items()})
         own.update({f"feature_q{i}": float(v) for i, v in enumerate(notes["feature_quat"])})

@@ -143,7 +143,8 @@ def test_jt_show_reads_the_server(runs, server, tmp_path, monkeypatch):
 def test_jt_ui_prints_the_server_url(server, tmp_path):
     t0 = time.monotonic()
     out = run_jt("ui", f"store={server.uri}/", cwd=tmp_path, timeout=60)
-    assert out.returncode == 0 and f"MLflow UI: {server.uri}  (served by the tracking server)" in out.stdout
+    assert out.returncode == 0 and f"MLflow UI: {server.uri}/#/experiments?workflowType=machine_learning  (served by the tracking server)" \
+        in out.stdout
     assert time.monotonic() - t0 < 30  # it starts nothing
 
 

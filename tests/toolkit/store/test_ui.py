@@ -60,6 +60,11 @@ def test_ui_serves_the_store_and_stops_with_jt(tmp_path):
         body = urllib.request.urlopen(f"http://127.0.0.1:{port}/ajax-api/2.0/mlflow/experiments/search?max_results=10",
                                       timeout=10).read().decode()
         assert '"exp"' in body
+        page = urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10).read().decode()
+        assert page.index('<script data-jt="defaults">') < page.index("static-files/static/js/main")  # jt's app
+        telemetry = urllib.request.urlopen(f"http://127.0.0.1:{port}/ajax-api/3.0/mlflow/ui-telemetry",
+                                           timeout=10).read().decode()
+        assert '"disable_ui_telemetry":true' in telemetry.replace(" ", "")
         t0 = time.monotonic()
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)

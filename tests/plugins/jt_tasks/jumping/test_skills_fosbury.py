@@ -13,6 +13,7 @@ import yaml
 
 from tests.conftest import run_jt
 from toolkit import play, skills
+from toolkit.config import compose_skill
 from toolkit.errors import JtError
 
 
@@ -89,7 +90,7 @@ def trained_run(fosbury, tmp_path_factory):
     art = root / "art"
     art.mkdir()
     shutil.copyfile(fosbury.policy, art / "ppo.h5")
-    (art / "config.yaml").write_text(to_yaml(skills.compose(fosbury)))
+    (art / "config.yaml").write_text(to_yaml(compose_skill(fosbury)))
     point = fosbury.point
     h5.write(art / "search_history.h5", {"names": np.array(list(point), dtype="S"), "index": np.array([0]),
                                           "x": np.array([list(point.values())]),
