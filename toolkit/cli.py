@@ -255,17 +255,19 @@ def play_cmd(
     from toolkit.quiet import preload_quietly
 
     preload_quietly()  # no native banner on the terminal
-    from toolkit import play
+    from toolkit import play, play_targets
 
     if ship is not None:
         if not ref:
             raise JtError("--ship RUN_ID NAME: give the skill's name after the run id")
-        skill = play.ship(ship, ref, store, out, description)
+        from toolkit.ship import ship as ship_run
+
+        skill = ship_run(ship, ref, store, out, description)
         typer.echo(f"skill {skill.name} (task={skill.task}) in {skill.folder}: {skills.measure_text(skill.measure)}")
         typer.echo(f"  jt play {skill.name}" if out is None else f"  jt play {skill.folder}")
         return
     play.check_options(width, height, seconds)
-    target = play.target_of(ref, store)
+    target = play_targets.target_of(ref, store)
     done = play.replay(target, out or play.DEFAULT_OUT, seconds, seed, start, gui, width, height)
     typer.echo(f"{target.label} (task={target.task_name}): {done.line}")
     files = ", ".join(str(f) for f in done.files) or "no frames"

@@ -22,17 +22,17 @@ the registry finds them, so the core names no task. A skill is one folder of tha
 * ``provenance``: ``command``, ``run_id`` (in the store that trained it), ``commit``, ``samples``,
   ``train_wall_s``, ``date``.
 
-``toolkit.play.ship(ref, name)`` (``jt play --ship RUN NAME``) writes such a folder from a run: the
+``toolkit.ship.ship(ref, name)`` (``jt play --ship RUN NAME``) writes such a folder from a run: the
 slim policy, the prior, the manifest from the run's command, tags and metrics, and its measure from
 one replay.
 A skill whose policy no longer fits the environment its overrides build (another observation or
 action size) is refused in one line that names the command retraining it (``check_fits``).
 
-``jt run task.evaluate=NAME`` measures a shipped skill as a run (``toolkit.policy.task``): the
+``jt run task.evaluate=NAME`` measures a shipped skill as a run (``toolkit.policy.trained``): the
 skill's overrides compose under the command line's (``evaluate_overrides``: the command line wins,
 a group it chooses otherwise drops the skill's keys of that group; ``toolkit.config.compose_skill``
 composes a skill's own), and the run's environment must be the skill's
-(``toolkit.policy.task.check_skill_settings``).
+(``toolkit.policy.trained.check_skill_settings``).
 """
 
 from __future__ import annotations
@@ -112,7 +112,7 @@ def evaluate_overrides(overrides: Any) -> list[str]:
     names one (``jt run task.evaluate=fosbury`` composes the Fosbury skill's environment): the
     command line's win, and a group it chooses otherwise (``search=bds``) drops the skill's keys
     of that group (``search.budget=1``). As given otherwise (an unknown name is the line of
-    ``toolkit.policy.task.trained_skill``, which names the shipped skills)."""
+    ``toolkit.policy.trained.trained_skill``, which names the shipped skills)."""
     overrides = list(overrides)
     refs = [o.split("=", 1)[1].strip().strip("'\"") for o in overrides if _key(o) == "task.evaluate" and "=" in o]
     if not refs or not is_skill_ref(refs[-1]):

@@ -56,7 +56,7 @@ def test_slim_of_a_slim_file_and_of_no_checkpoint(full, tmp_path):
 
 
 def test_task_evaluate_refuses_a_slim_policy(full, tmp_path):
-    from toolkit.policy.task import trained_policy
+    from toolkit.policy.trained import trained_policy
 
     dst = ckpt.slim(full, tmp_path / "policy.h5")
     with pytest.raises(JtError, match="is a slim policy .* replay it with: jt play"):

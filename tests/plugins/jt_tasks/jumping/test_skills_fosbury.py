@@ -1,6 +1,7 @@
-"""The shipped ``fosbury`` skill replayed (``jt play fosbury``, toolkit/play.py): real PyBullet, its
-slim policy and prior from the repository. The jump is ~0.6 s of simulation; it clears the 1.00 m
-bar with the documented strategy feature. A run of a store replays and ships the same way."""
+"""The shipped ``fosbury`` skill replayed (``jt play fosbury``: toolkit/play.py, play_targets.py,
+ship.py): real PyBullet, its slim policy and prior from the repository. The jump is ~0.6 s of
+simulation; it clears the 1.00 m bar with the documented strategy feature. A run of a store replays
+and ships the same way."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pytest
 import yaml
 
 from tests.conftest import run_jt
-from toolkit import play, skills
+from toolkit import play, play_targets, skills
 from toolkit.config import compose_skill
 from toolkit.errors import JtError
 
@@ -24,7 +25,7 @@ def fosbury():
 
 @pytest.fixture(scope="module")
 def target(fosbury):
-    return play.from_skill(fosbury)
+    return play_targets.from_skill(fosbury)
 
 
 def test_fosbury_clears_its_bar_as_documented(target, fosbury, tmp_path):
@@ -104,7 +105,7 @@ def trained_run(fosbury, tmp_path_factory):
 
 def test_a_run_replays_at_the_bar_its_final_rollout_reached(trained_run, tmp_path):
     st, rid, art = trained_run
-    target = play.from_run(rid, str(st.root))
+    target = play_targets.from_run(rid, str(st.root))
     assert target.label == f"run-{rid[:8]}" and target.task_name == "highjump"
     assert target.env_attrs["bar_height"] == 1.0  # the checkpoint says 1.02: the run's metrics win
     assert target.point == {"alpha": -0.05, "omega_x": -3.0, "omega_z": 1.0, "v_z": -2.4}
@@ -112,13 +113,15 @@ def test_a_run_replays_at_the_bar_its_final_rollout_reached(trained_run, tmp_pat
     bare.mkdir()
     shutil.copyfile(art / "ppo.h5", bare / "ppo.h5")
     shutil.copyfile(art / "config.yaml", bare / "config.yaml")
-    alone = play.from_run(str(bare))
+    alone = play_targets.from_run(str(bare))
     assert alone.env_attrs["bar_height"] == 1.02 and alone.point == {} and alone.label == "highjump-bare"
 
 
 def test_ship_makes_a_skill_from_a_run(trained_run, fosbury, tmp_path):
     st, rid, _ = trained_run
-    skill = play.ship(rid, "flop", str(st.root), tmp_path / "skills", "a copy")
+    from toolkit.ship import ship
+
+    skill = ship(rid, "flop", str(st.root), tmp_path / "skills", "a copy")
     again = skills.load_manifest(tmp_path / "skills" / "flop")
     assert again.name == "flop" and again.description == "a copy" and again.task == "highjump"
     assert again.measure == skill.measure == fosbury.measure
