@@ -62,7 +62,7 @@ def test_each_choice_composes_or_is_one_line(task, tmp_path):
     (["task=spacetime", "reward=getup"], "does not read a reward group"),
     (["task=spacetime", "curriculum=terrain"], "does not read a curriculum group"),
     (["task=getup", "curriculum=bar_height"], "drives bar_height"),
-    (["task=getup", "action=ffc_fbc"], "needs phase from the task"),
+    (["task=highjump", "action=ffc_fbc"], "needs phase from the task"),
     (["task=highjump", "reward=getup"], "reads record key(s) h, target_h"),
     (["task=highjump", "curriculum=terrain"], "drives terrain_level"),
     (["task=obstacle", "curriculum=bar_height"], "drives bar_height"),

@@ -60,16 +60,13 @@ def _tree(path: Path, group: str = "") -> dict:
 
 @pytest.mark.parametrize("task", ["highjump", "runup"])
 def test_same_seed_curve_equals_the_recording_before_the_layer(task, tmp_path):
-    from toolkit.config import compose
-    from toolkit.execution.runner import run
+    from tests.conftest import run_jt
 
-    res = run(compose([f"task={task}", "experiment=smoke", "agent.total_samples=256", "spd=maba",
-                       f"store={tmp_path}"]))
-    art = res.store.artifact_dir(res.run_id) if (res.store.artifact_dir(res.run_id) / "ppo.h5").exists() else None
-    if art is None:  # a search: the evaluation is the nested run
-        kids = res.store.client.search_runs([res.store.client.get_run(res.run_id).info.experiment_id],
-                                            filter_string=f"tags.mlflow.parentRunId = '{res.run_id}'")
-        art = res.store.artifact_dir(kids[0].info.run_id)
+    # a fresh process, as a user's `jt run`: in a test process that trained other policies before, the
+    # high jump's 4th iteration moved by ~2e-8 (a process-state dependence not yet found: docs/ppo.md)
+    done = run_jt("run", f"task={task}", "experiment=smoke", "agent.total_samples=256", "spd=maba", f"store={tmp_path}")
+    assert done.returncode == 0, done.stderr
+    art = next(p.parent for p in sorted((tmp_path / "runs").rglob("ppo.h5")))
     original = json.loads((GOLDEN / f"{task}_smoke.json").read_text())
     hist, ro = _tree(art / "ppo.h5", "history"), _tree(art / "rollout.h5")
     own = GOLDEN / f"{task}_smoke.{machine_key()}.json"
