@@ -65,6 +65,15 @@ def run_jt(*args: str, extra_path: Path | None = None, cwd: Path | None = None,
                           env=jt_env(extra_path), cwd=cwd, timeout=timeout)
 
 
+def one_line_error(p: subprocess.CompletedProcess, code: int = 2) -> str:
+    """The one ``jt: ...`` line a refused command printed (exit ``code``, no traceback)."""
+    assert p.returncode == code, p.stderr[-500:]
+    err = p.stderr.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in p.stderr and "internal error" not in err, err
+    assert err.startswith("jt: ")
+    return err
+
+
 def store_query(store: Path, sql: str, *params: object) -> list[tuple]:
     """Rows of ``sql`` on a store's ``mlflow.db`` read directly (what a run left behind, even while
     it runs); ``[]`` while a writer holds the lock or before the tables exist."""

@@ -9,17 +9,9 @@ import shutil
 import pytest
 import yaml
 
-from tests.conftest import run_jt
+from tests.conftest import one_line_error, run_jt
 from toolkit import skills
 from toolkit.errors import JtError
-
-
-def _one_line(p, code=2) -> str:
-    assert p.returncode == code, p.stderr[-500:]
-    err = p.stderr.strip()
-    assert len(err.splitlines()) == 1 and "Traceback" not in p.stderr and "internal error" not in err, err
-    assert err.startswith("jt: ")
-    return err
 
 
 @pytest.fixture()
@@ -127,11 +119,11 @@ def test_jt_play_lists_the_skills():
 
 
 def test_jt_play_mistakes_are_one_line(tmp_path):
-    assert "unknown skill 'nope'; shipped skills: " in _one_line(run_jt("play", "nope"))
-    assert "renders at least 320x240 px" in _one_line(run_jt("play", "fosbury", "--width", "100"))
-    assert "--seconds 0.0: must be a number of seconds > 0" in _one_line(run_jt("play", "fosbury", "--seconds", "0"))
-    err = _one_line(run_jt("play", "0123456789abcdef0123456789abcdef", "--store", str(tmp_path / "none")))
+    assert "unknown skill 'nope'; shipped skills: " in one_line_error(run_jt("play", "nope"))
+    assert "renders at least 320x240 px" in one_line_error(run_jt("play", "fosbury", "--width", "100"))
+    assert "--seconds 0.0: must be a number of seconds > 0" in one_line_error(run_jt("play", "fosbury", "--seconds", "0"))
+    err = one_line_error(run_jt("play", "0123456789abcdef0123456789abcdef", "--store", str(tmp_path / "none")))
     assert err.startswith("jt: jt play 0123456789abcdef0123456789abcdef: no such run")
-    assert "no ppo.h5 there" in _one_line(run_jt("play", str(tmp_path)))
-    assert "give the run's id" in _one_line(run_jt("play", "--ship", str(tmp_path), "x"))
-    assert "give the skill's name" in _one_line(run_jt("play", "--ship", "0123456789abcdef0123456789abcdef"))
+    assert "no ppo.h5 there" in one_line_error(run_jt("play", str(tmp_path)))
+    assert "give the run's id" in one_line_error(run_jt("play", "--ship", str(tmp_path), "x"))
+    assert "give the skill's name" in one_line_error(run_jt("play", "--ship", "0123456789abcdef0123456789abcdef"))

@@ -8,16 +8,8 @@ import sys
 
 import pytest
 
-from tests.conftest import jt_env, run_jt
+from tests.conftest import jt_env, one_line_error, run_jt
 from toolkit.errors import JtError
-
-
-def _one_line(p, code=2) -> str:
-    assert p.returncode == code, p.stderr[-500:]
-    err = p.stderr.strip()
-    assert len(err.splitlines()) == 1 and "Traceback" not in p.stderr and "internal error" not in err, err
-    assert err.startswith("jt: ")
-    return err
 
 
 @pytest.fixture(scope="module")
@@ -58,19 +50,19 @@ def test_jt_study_lists_every_tasks_tools_with_their_summaries():
 
 
 def test_an_unknown_task_or_tool_is_one_line_naming_the_choices():
-    err = _one_line(run_jt("study", "nosuch"))
+    err = one_line_error(run_jt("study", "nosuch"))
     assert "no study tools for task 'nosuch'" in err and "spacetime" in err and "highjump" in err
-    err = _one_line(run_jt("study", "spacetime", "nosuch"))
+    err = one_line_error(run_jt("study", "spacetime", "nosuch"))
     assert err == ("jt: unknown tool 'nosuch' of task=spacetime; "
                    "choose one of: bounds, policy-bounds, style, survival, toy")
 
 
 def test_a_tools_bad_argument_is_one_line_and_help_is_its_usage(tmp_path):
-    err = _one_line(run_jt("study", "highjump", "curves", "--nosuch"))
+    err = one_line_error(run_jt("study", "highjump", "curves", "--nosuch"))
     assert err.startswith("jt: jt study highjump curves: ") and "(see jt study highjump curves --help)" in err
-    err = _one_line(run_jt("study", "highjump", "curves", str(tmp_path / "x.h5"), "--nosuch"))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(tmp_path / "x.h5"), "--nosuch"))
     assert "unrecognized arguments: --nosuch" in err
-    err = _one_line(run_jt("study", "highjump", "curves", str(tmp_path / "missing.h5")))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(tmp_path / "missing.h5")))
     assert err == f"jt: file {tmp_path / 'missing.h5'}: no such file"
     h = run_jt("study", "highjump", "curves", "--help")
     assert h.returncode == 0 and h.stdout.startswith("usage: jt study highjump curves ") and h.stderr == ""
@@ -130,18 +122,18 @@ def test_jump_curves_refuse_another_tasks_file_and_an_unwritable_out_in_one_line
     other.parent.mkdir()
     with h5py.File(other, "w") as f:  # a ppo.h5 of another task: no curriculum curve
         f.create_dataset("history/mean_return", data=np.zeros(2))
-    err = _one_line(run_jt("study", "highjump", "curves", str(other)))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(other)))
     assert "no jump curriculum curve in it (extra/z_history)" in err
     (other.parent / "config.yaml").write_text("task:\n  name: spacetime\n")  # a run's work folder says so
-    err = _one_line(run_jt("study", "highjump", "curves", str(other)))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(other)))
     assert err == (f"jt: {other}: a task=spacetime run; "
                    "jt study highjump curves reads task=highjump/obstacle/longjump runs")
     (tmp_path / "file").write_text("")
-    err = _one_line(run_jt("study", "highjump", "curves", str(jump_ppo), "--out", str(tmp_path / "file" / "c.png")))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(jump_ppo), "--out", str(tmp_path / "file" / "c.png")))
     assert err.startswith(f"jt: --out={tmp_path / 'file' / 'c.png'}: cannot write there")
-    err = _one_line(run_jt("study", "highjump", "curves", str(jump_ppo), "--out", str(tmp_path / "c.pdf")))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(jump_ppo), "--out", str(tmp_path / "c.pdf")))
     assert "--out=" in err and "a .png file" in err
-    err = _one_line(run_jt("study", "highjump", "curves", str(jump_ppo), str(jump_ppo), "--labels", "one"))
+    err = one_line_error(run_jt("study", "highjump", "curves", str(jump_ppo), str(jump_ppo), "--labels", "one"))
     assert "--labels: 1 labels for 2 files" in err
 
 
