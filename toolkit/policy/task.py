@@ -44,7 +44,8 @@ from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
 from toolkit.policy import train as tr
 from toolkit.policy.episodes import Rollout, opened_env, rollout
-from toolkit.policy.trained import adopt_checkpoint, adopt_skill, check_policy_fits, trained_policy, trained_skill
+from toolkit.policy.trained import (adopt_checkpoint, adopt_skill, check_policy_fits, trained_policy, trained_skill,
+                                    warm_policy)
 
 
 def require_character_and_prior(cfg: Any, task: str, character: str, why: str) -> None:
@@ -75,6 +76,9 @@ def require_character_and_prior(cfg: Any, task: str, character: str, why: str) -
     path = trained_policy(cfg, task)  # task.evaluate names a trained policy that exists
     if path is not None and prior != "auto":  # auto: checked again once the runner has found it
         check_policy_fits(cfg, task, path)
+    warm = warm_policy(cfg, task)  # task.warm_start names a full checkpoint of this environment's sizes
+    if warm is not None and prior != "auto":
+        check_policy_fits(cfg, task, warm, "warm_start")
 
 
 @dataclasses.dataclass
@@ -95,6 +99,11 @@ class PolicyConfig:
     compose under the command line's, its environment attributes are set, and the run's
     environment must be the skill's). Its policy is rolled out and measured with this run's
     settings and no sample is collected (jt; e.g. ``003`` Table 1 of a policy trained earlier)."""
+    warm_start: str = ""
+    """A trained policy that training starts from instead of fresh networks: a run id (its best
+    evaluation), a folder or a ``ppo.h5`` (its policy, value network and observation normaliser;
+    fresh optimiser, counters and budget; jt, for fine-tuning under changed settings: e.g. the
+    get-up's smaller exploration noise, docs/getup.md)."""
 
 
 @dataclasses.dataclass
@@ -242,7 +251,7 @@ class PolicyTask(Task):
         else:
             trained = tr.train_policy(tr.EnvFactory(self.env_class, spec), group_of(self.cfg, "agent"),
                                       group_of(self.cfg, "executor"), workdir, ctx.seed, hooks.on_iteration,
-                                      hooks.extra, hooks.should_stop, hooks.warm_start,
+                                      hooks.extra, hooks.should_stop, hooks.warm_start or warm_policy(self.cfg, name),
                                       adopt_checkpoint(self.cfg, name, workdir))
         model = load_policy(trained.checkpoint)
         outer.report(TRAIN_SHARE, "final rollout")

@@ -8,6 +8,9 @@ are those of the task's environment as configured, and ``check_skill_settings`` 
 environment is the run's. ``PolicyTask.evaluate`` then takes the policy into the evaluation's
 folder instead of training one: ``adopt_checkpoint`` (a run's full checkpoint, resumed with no
 sample left to collect) or ``adopt_skill`` (a skill's slim policy).
+
+``PolicyConfig.warm_start`` names a trained run's full checkpoint that training starts from
+(``warm_policy``: its networks and normaliser, fresh optimiser and counters; checked the same way).
 """
 
 from __future__ import annotations
@@ -22,15 +25,16 @@ from toolkit.policy import train as tr
 from toolkit.policy.episodes import opened_env
 
 
-def check_policy_fits(cfg: Any, task: str, path: Path) -> None:
-    """``task.evaluate``'s policy takes the observation and gives the action of ``task``'s
-    environment as configured (sizes from the checkpoint, against an environment built here):
-    a run of another task, or of other settings, is one ``JtError`` line before a run opens."""
+def check_policy_fits(cfg: Any, task: str, path: Path, key: str = "evaluate") -> None:
+    """``task.<key>``'s policy (``evaluate``, ``warm_start``) takes the observation and gives the
+    action of ``task``'s environment as configured (sizes from the checkpoint, against an
+    environment built here): a run of another task, or of other settings, is one ``JtError``
+    line before a run opens."""
     from toolkit import plugins
     from toolkit.errors import JtError
     from toolkit.rl.checkpoint import load_attrs
 
-    skill = trained_skill(cfg, task)
+    skill = trained_skill(cfg, task) if key == "evaluate" else None
     if skill is not None:
         check_skill_settings(cfg, task, skill)
     attrs = load_attrs(path)
@@ -38,8 +42,8 @@ def check_policy_fits(cfg: Any, task: str, path: Path) -> None:
     with opened_env(plugins.load("task", task)(cfg).make_env, seed=0) as env:
         have = (int(env.observation_space.shape[0]), int(env.action_space.shape[0]))
     if want != have:
-        ref = str(group_of(group_of(cfg, "task"), "evaluate")).strip()
-        raise JtError(f"task.evaluate={ref}: its policy takes {want[0]} observations and gives {want[1]} actions; "
+        ref = str(group_of(group_of(cfg, "task"), key)).strip()
+        raise JtError(f"task.{key}={ref}: its policy takes {want[0]} observations and gives {want[1]} actions; "
                       f"task={task} as configured here observes {have[0]} and acts with {have[1]} "
                       f"(a run of another task, or of other task/action settings)")
 
@@ -70,6 +74,35 @@ def trained_policy(cfg: Any, task: str) -> Optional[Path]:
         raise JtError(f"task.evaluate={ref}: {path} is a slim policy (a shipped skill's: no value network or "
                       f"training state); measure a shipped skill by its name (task.evaluate=NAME, jt play lists "
                       f"them) or replay it with: jt play {ref}")
+    return path
+
+
+def warm_policy(cfg: Any, task: str) -> Optional[Path]:
+    """The full ``ppo.h5`` that ``task.warm_start`` names (a run id, a folder or the file), or None
+    when it is unset; one ``JtError`` line when it names nothing, a file that is no PPO checkpoint,
+    a slim policy (no value network), or comes with ``task.evaluate``."""
+    group = group_of(cfg, "task") or {}
+    ref = str(group_of(group, "warm_start") or "").strip()
+    if not ref:
+        return None
+    from toolkit.errors import JtError
+
+    if str(group_of(group, "evaluate") or "").strip():
+        raise JtError(f"task.warm_start={ref}: task.evaluate measures a trained policy without training; "
+                      "give one of the two")
+    from toolkit.rl.checkpoint import load_attrs
+    from toolkit.store.resolve import resolve
+
+    store = group_of(cfg, "store")
+    path = resolve(ref, artifact=tr.CHECKPOINT, store=None if store is None else str(store),
+                   what="task.warm_start", label="trained policy", hint=f"train one with: jt run task={task}").path
+    try:
+        attrs = load_attrs(path)
+    except (OSError, ValueError, KeyError) as e:
+        raise JtError(f"task.warm_start={ref}: {path} is not a jt PPO checkpoint ({str(e).splitlines()[0][:160]})") from None
+    if attrs.get("slim"):
+        raise JtError(f"task.warm_start={ref}: {path} is a slim policy (a shipped skill's: no value network); "
+                      "start from a trained run's ppo.h5")
     return path
 
 
