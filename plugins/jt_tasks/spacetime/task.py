@@ -37,6 +37,8 @@ class SpacetimeTask(PolicyTask):
     key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "samples", "train_mean_length")
     Config: ClassVar[type] = SpacetimeConfig
     env_path: ClassVar[str] = "jt_tasks.spacetime.env:SpacetimeEnv"
+    #: ``jt play NAME``: the walk and run of ``experiment=laptop`` (Table 1's 20 s), a folder each
+    skills: ClassVar[str] = "jt_tasks.spacetime.skills"
     #: its rewards are task.style's terms and the bounds; no curriculum drives it
     ignores_groups: ClassVar[tuple[str, ...]] = ("reward", "curriculum")
     action_inputs: ClassVar[frozenset[str]] = frozenset({"phase"})  #: the reference clip's phase
@@ -128,6 +130,23 @@ class SpacetimeTask(PolicyTask):
                 raise JtError(f"--start={start}: task=spacetime starts at a clip phase in [0, 1]")
             options["phase"] = phase
         return options
+
+    def play_summary(self, env: Any, ro: Rollout) -> tuple[dict[str, Any], str]:
+        """Table 1's measure of one replay: the seconds survived from its start phase and whether
+        the episode ran to its end; ``{"survival_s", "survived", "start_phase"}``."""
+        _, tail = super().play_summary(env, ro)
+        t = float(ro.info.get("survival_s", env.t))
+        survived = bool(ro.info.get("time_out", 0.0))
+        phase = float(env.phase0)
+        reason = str(ro.info.get("reason", "") or "")
+        if survived:
+            head = f"survived {t:.2f} s (the whole episode)"
+        elif reason:
+            head = f"fell at {t:.2f} s ({reason})"
+        else:
+            head = f"still up at {t:.2f} s"
+        measure = {"survival_s": round(t, 2), "survived": survived, "start_phase": round(phase, 3)}
+        return measure, f"{Path(str(env.spec_.clip)).stem}: {head} from clip phase {phase:.2f} ({tail})"
 
     def rollout_data(self, ro: Rollout, env: Any, spec: Any) -> tuple[dict, dict]:
         from jt_tasks.spacetime.artifacts import com_height_data

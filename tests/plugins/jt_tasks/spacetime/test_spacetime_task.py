@@ -155,3 +155,30 @@ def test_jt_play_start_is_the_clip_phase():
     for bad in ("1.5", "x", "nan"):
         with pytest.raises(JtError, match=r"--start=.*: task=spacetime starts at a clip phase in \[0, 1\]"):
             t.play_options(None, bad)
+
+
+class _Still:
+    """Zero corrections: the feed-forward alone (the clip's pose ahead)."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+
+    def act(self, obs):
+        return np.zeros(self.n)
+
+
+def test_jt_play_summary_says_how_long_it_survived_from_which_phase():
+    from toolkit.policy.episodes import opened_env, rollout
+
+    t, _ = task("task.clip=walk")
+    with opened_env(t.make_env, {}, seed=0) as env:
+        still = _Still(env.action_space.shape[0])
+        ro = rollout(env, still, t.record, options=t.play_options(env, "0.25"))
+        measure, line = t.play_summary(env, ro)
+        assert measure["survived"] is False and measure["start_phase"] == 0.25
+        assert 0.0 < measure["survival_s"] < 5.0  # the feed-forward alone falls within seconds
+        assert line.startswith(f"walk: fell at {measure['survival_s']:.2f} s (") and "from clip phase 0.25" in line
+        ro = rollout(env, still, t.record, options=t.play_options(env, "0.25"), max_steps=3)
+        measure, line = t.play_summary(env, ro)
+    assert measure == {"survival_s": 0.1, "survived": False, "start_phase": 0.25}
+    assert line.startswith("walk: still up at 0.10 s from clip phase 0.25")
