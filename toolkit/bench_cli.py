@@ -241,3 +241,44 @@ def bench_rollout(
         json_out.parent.mkdir(parents=True, exist_ok=True)
         json_out.write_text(json.dumps(out, indent=2))
         typer.echo(f"wrote {json_out}")
+
+
+@bench_app.command("evaluation", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
+def bench_evaluation(
+    overrides: Optional[List[str]] = typer.Argument(None, help="jt run's overrides (e.g. task=highjump "
+                                                    "search=single experiment=laptop)."),
+    store: Optional[Path] = typer.Option(None, "--store", help="The store to run in (a kept one reuses its pose "
+                                         "prior); default: a fresh temporary one, removed after."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the breakdown as JSON here."),
+    quiet: bool = typer.Option(False, "--quiet", help="Do not show the run's own output."),
+) -> None:
+    """Where one jt run's wall time goes: collection, PPO update, the task's hooks (curriculum
+    rollouts), checkpoints, final rollout, pictures, measures, prior, and the rest (process start,
+    store); samples per wall-second (docs/performance.md)."""
+    import shutil
+    import tempfile
+
+    from toolkit.eval_bench import breakdown, format_breakdown
+
+    extra = list(overrides or [])
+    dashed = [o for o in extra if o.startswith("-")]
+    if dashed:
+        raise JtError(f"no such option: {dashed[0]} (see: jt bench evaluation --help)")
+    if not extra:
+        raise JtError("jt bench evaluation needs jt run's overrides, e.g.: jt bench evaluation task=highjump "
+                      "search=single experiment=laptop")
+    from toolkit.config import compose
+
+    compose(extra)  # a mistake is one line before anything runs
+    writable(json_out, "--json")
+    tmp = None if store is not None else Path(tempfile.mkdtemp(prefix="jt-bench-eval-"))
+    try:
+        res = breakdown(extra, store if store is not None else tmp, echo=None if quiet else typer.echo)
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+    typer.echo(format_breakdown(res))
+    if json_out:
+        json_out.parent.mkdir(parents=True, exist_ok=True)
+        json_out.write_text(json.dumps({"machine": machine_info(), **res}, indent=2))
+        typer.echo(f"wrote {json_out}")

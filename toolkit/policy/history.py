@@ -68,6 +68,33 @@ def base_metrics(ro: Any, trained: Any) -> dict[str, float]:
             "samples_per_s": float(trained.samples_per_s), "train_wall_s": float(trained.wall_s)}
 
 
+def time_breakdown(trained: Any, clock: list[float]) -> dict[str, float]:
+    """Where an evaluation's wall time went (s), as ``time_*_s`` metrics (``jt bench evaluation``).
+
+    Args:
+        trained: ``toolkit.policy.train.Trained`` (its PPO history holds ``collect_s``,
+            ``update_s`` and ``hook_s`` per iteration; its result ``startup_s`` and ``checkpoint_s``).
+        clock: ``perf_counter`` readings: before the final rollout, after it, after its pictures
+            and ``rollout.h5`` were written, after the task's ``measure``.
+
+    Returns:
+        ``time_train_s`` (the whole of PPO's training, workers started and closed), its parts
+        ``time_startup_s``, ``time_collect_s``, ``time_update_s``, ``time_hooks_s`` (the task's
+        per-iteration hook: a curriculum's deterministic rollouts), ``time_checkpoint_s``; then
+        ``time_final_rollout_s``, ``time_pictures_s``, ``time_measure_s``.
+    """
+    res, hist = trained.result, trained.result.history
+
+    def total(key: str) -> float:
+        return float(np.nansum(np.asarray(hist.get(key, []), dtype=np.float64)))
+
+    return {"time_train_s": float(trained.wall_s), "time_startup_s": float(getattr(res, "startup_s", 0.0)),
+            "time_collect_s": total("collect_s"), "time_update_s": total("update_s"),
+            "time_hooks_s": total("hook_s"), "time_checkpoint_s": float(getattr(res, "checkpoint_s", 0.0)),
+            "time_final_rollout_s": clock[1] - clock[0], "time_pictures_s": clock[2] - clock[1],
+            "time_measure_s": clock[3] - clock[2]}
+
+
 def measured(ro: Any, trained: Any, metrics: Mapping[str, float],
              curves: Optional[Mapping[str, list]] = None,
              keep_nonfinite: bool = False) -> tuple[dict[str, float], dict[str, list]]:

@@ -36,6 +36,7 @@ A task constructed without a config (``Task(None)``) composes its own defaults
 from __future__ import annotations
 
 import dataclasses
+import time
 from pathlib import Path
 from typing import Any, Callable, ClassVar, Optional
 
@@ -44,6 +45,7 @@ from toolkit.interfaces.task import EvalContext, Evaluation, Task
 
 from toolkit.policy import train as tr
 from toolkit.policy.episodes import Rollout, opened_env, rollout
+from toolkit.policy.history import time_breakdown
 from toolkit.policy.trained import (adopt_checkpoint, adopt_skill, check_policy_fits, trained_policy, trained_skill,
                                     warm_policy)
 
@@ -255,6 +257,7 @@ class PolicyTask(Task):
                                       adopt_checkpoint(self.cfg, name, workdir))
         model = load_policy(trained.checkpoint)
         outer.report(TRAIN_SHARE, "final rollout")
+        clock = [time.perf_counter()]
         with opened_env(self.env_class, spec, seed=ctx.seed) as env:
             self.final_env(env, hooks, trained)
             for key, value in attrs.items():  # as jt play sets them
@@ -266,10 +269,14 @@ class PolicyTask(Task):
                     break
             data, attrs = self.rollout_data(ro, env, spec)
             fps = float(env.control_hz)
+        clock.append(time.perf_counter())
         written = tr.save_motion(workdir, ro.frames, p.filmstrip_frames, fps)
         h5.write(workdir / "rollout.h5", {"time": ro.time, "root": ro.root, "com": ro.com, **data}, attrs)
+        clock.append(time.perf_counter())
         outer.report(TRAIN_SHARE + 0.02, "measuring the trained policy")
         ev = self.measure(spec, ro, trained, hooks, workdir)
+        clock.append(time.perf_counter())
+        ev.metrics.update(time_breakdown(trained, clock))
         outer.report(1.0, "done")
         if ev.artifacts is None:
             ev.artifacts = [n for n in (tr.CHECKPOINT, "rollout.h5", *written) if (workdir / n).exists()] + \

@@ -67,6 +67,10 @@ class IterationStats(dict):
         self.model = model
 
 
+TIMING = ("samples_per_s", "collect_s", "update_s", "hook_s")
+"""History keys that are wall-clock times (s) or rates: they differ between identical runs."""
+
+
 @dataclasses.dataclass
 class TrainResult:
     """What ``train`` returns.
@@ -78,6 +82,9 @@ class TrainResult:
         history: per-iteration scalar stats ``{name: [value per iteration]}``.
         extra: the caller's ``extra`` dict (restored from the checkpoint on resume).
         checkpoint_path: the last checkpoint written, if any.
+        startup_s: wall time (s) of this call before its first collection: the probe env, the
+            networks, a checkpoint or warm start read, the rollout workers started.
+        checkpoint_s: wall time (s) this call spent writing checkpoints.
     """
 
     model: ActorCritic
@@ -86,6 +93,8 @@ class TrainResult:
     history: dict[str, list[float]]
     extra: dict[str, Any]
     checkpoint_path: Optional[Path] = None
+    startup_s: float = 0.0
+    checkpoint_s: float = 0.0
 
 
 def action_std(samples: float, cfg: PPOConfig) -> float:
@@ -297,6 +306,7 @@ def train(
             PPO checkpoint, or of other observation/action sizes or network layout.
     """
     cfg.check()
+    t_start = time.perf_counter()
     extra = {} if extra is None else extra
     obs_dim, act_dim, low, high, out_scale = _probe(env_fn, cfg.seed)
     torch.manual_seed(cfg.seed)
@@ -335,6 +345,15 @@ def train(
 
     saved: Optional[Path] = None
     first = True
+    saving = [0.0]  # s spent writing checkpoints
+
+    def timed_save() -> Path:
+        t = time.perf_counter()
+        out = save()
+        saving[0] += time.perf_counter() - t
+        return out
+
+    startup_s = time.perf_counter() - t_start
     try:
         if env_attrs:
             workers.call("set_env_attrs", [(env_attrs,)] * workers.size)
@@ -395,6 +414,7 @@ def train(
             }
             for k, v in stats.items():
                 history.setdefault(k, []).append(float(v))
+            t3 = time.perf_counter()
             if on_iteration is not None:
                 visits = [{**v, "value": float(batch["values"][v["step"], v["env"]]),
                            "target": float(targets[v["step"], v["env"]])} for v in batch.get("visits", [])]
@@ -402,13 +422,14 @@ def train(
                 if attrs:
                     env_attrs.update(attrs)
                     workers.call("set_env_attrs", [(dict(attrs),)] * workers.size)
+            history.setdefault("hook_s", []).append(time.perf_counter() - t3)  # the caller's hook (a curriculum's rollouts)
             if path is not None and iteration % cfg.checkpoint_every == 0:
-                saved = save()
+                saved = timed_save()
             stopping.check()  # a safe point (SIGTERM): a resume repeats from the last checkpoint, bit for bit
             if should_stop is not None and should_stop():
                 break
         if path is not None:
-            saved = save()
+            saved = timed_save()
     finally:
         workers.close()
-    return TrainResult(model, iteration, samples, history, extra, saved)
+    return TrainResult(model, iteration, samples, history, extra, saved, startup_s, saving[0])

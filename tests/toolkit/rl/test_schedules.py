@@ -7,12 +7,13 @@ import torch
 from toolkit.rl import checkpoint as ckpt
 from toolkit.rl.ppo import PPOConfig, action_std, learning_rates, train
 from toolkit.rl.sanity import GymEnvFn
+from toolkit.rl.ppo import TIMING as ppo_timing
 
 ENV = GymEnvFn("Pendulum-v1", max_episode_steps=50)
-TIMING = {"samples_per_s", "collect_s", "update_s"}
+TIMING = set(ppo_timing)  # wall-clock keys: they differ between identical runs
 DEFAULT_KEYS = ["mean_return", "mean_length", "n_episodes", "mean_reward", "policy_loss", "value_loss",
                 "clip_frac", "approx_kl", "epochs_run", "explained_variance", "action_std",
-                "samples_per_s", "collect_s", "update_s"]
+                "samples_per_s", "collect_s", "update_s", "hook_s"]
 
 
 def tiny(**kw) -> PPOConfig:
