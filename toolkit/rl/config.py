@@ -113,6 +113,11 @@ class PPOConfig:
     results do not depend on the executor."""
     envs_per_worker: int = 16
     """Environments per worker, stepped in lock-step (16 → 256 steps each per iteration)."""
+    update_threads: int = 0
+    """Torch threads of the driver's PPO update (0: torch's default, one per core). Where the
+    rollout workers or another run share the cores, 1 keeps the update's threads from waiting on
+    each other (docs/performance.md). Another value changes the update's floating-point sums, so
+    the same seed gives the same result for the same value only."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able dict (tuples become lists)."""
@@ -143,6 +148,8 @@ class PPOConfig:
             v = getattr(self, key)
             if not (_is_int(v) and v >= 1):
                 raise bad(key, v, "must be an integer >= 1")
+        if not (_is_int(self.update_threads) and self.update_threads >= 0):
+            raise bad("update_threads", self.update_threads, "must be an integer >= 0 (0: torch's default)")
         if not (_is_int(self.seed) and self.seed >= 0):
             raise bad("seed", self.seed, "must be an integer >= 0")
         for key, low in (("samples_per_iteration", 1), ("total_samples", 0), ("obs_norm_max_samples", 0)):

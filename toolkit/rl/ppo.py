@@ -29,7 +29,7 @@ from toolkit.rl import checkpoint as ckpt
 from toolkit.rl.checkpoint import architecture_of, with_architecture
 from toolkit.rl.config import PPOConfig, scheduled
 from toolkit.rl.networks import ActorCritic, RunningObsStats, gaussian_log_prob
-from toolkit.rl.rollout import merge_batches, start_workers
+from toolkit.rl.rollout import merge_batches, start_workers, torch_threads
 
 __all__ = ["IterationStats", "PPOConfig", "TrainResult", "action_std", "architecture_of", "compute_gae",
            "learning_rates", "ppo_update", "train", "with_architecture"]
@@ -382,7 +382,8 @@ def train(
                     "logp": batch["logp"].reshape(-1), "adv": adv.reshape(-1),
                     "targets": targets.reshape(-1)}
             # 3. update policy and value, then the observation normaliser (used from next batch)
-            losses = ppo_update(model, pi_opt, v_opt, flat, std, cfg, rng)
+            with torch_threads(cfg.update_threads):
+                losses = ppo_update(model, pi_opt, v_opt, flat, std, cfg, rng)
             if cfg.obs_norm:
                 obs_stats.update(flat["obs"])
                 mean, sd = obs_stats.mean_std()

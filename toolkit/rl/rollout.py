@@ -49,6 +49,19 @@ def single_thread() -> Iterator[None]:
             torch.set_num_threads(n)
 
 
+@contextlib.contextmanager
+def torch_threads(n: int) -> Iterator[None]:
+    """Run torch on ``n`` threads inside the block (0: leave torch's count as it is)."""
+    before = torch.get_num_threads()
+    if n and n != before:
+        torch.set_num_threads(int(n))
+    try:
+        yield
+    finally:
+        if n and n != before:
+            torch.set_num_threads(before)
+
+
 def _scalars(info: dict[str, Any]) -> dict[str, float]:
     """The numeric scalar entries of a step ``info`` (keys starting with ``_`` skipped)."""
     out: dict[str, float] = {}

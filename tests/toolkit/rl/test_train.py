@@ -8,9 +8,9 @@ import pytest
 import torch
 
 from toolkit.rl import checkpoint as ckpt
+from toolkit.rl.ppo import TIMING as ppo_timing
 from toolkit.rl.ppo import PPOConfig, train
 from toolkit.rl.sanity import GymEnvFn
-from toolkit.rl.ppo import TIMING as ppo_timing
 
 ENV = GymEnvFn("Pendulum-v1", max_episode_steps=50)
 TIMING = set(ppo_timing)  # wall-clock keys: they differ between identical runs
@@ -183,3 +183,17 @@ def test_an_env_output_scale_is_the_learners_mean_too():
     r = train(ScaledEnvFn(), cfg)
     assert r.model.out_scale is not None and r.model.out_scale[0] == 3.0
     assert r.history["approx_kl"][0] < 1e-3 and r.history["clip_frac"][0] < 0.01
+
+
+def test_the_update_on_one_thread_is_seeded_and_leaves_torchs_threads_as_they_were():
+    """``update_threads=1`` (a run sharing its cores): the same seed gives the same run, the
+    driver's thread count is back after training, and every wall-clock part is recorded."""
+    before = torch.get_num_threads()
+    r1 = train(ENV, tiny(update_threads=1, n_workers=1))
+    assert torch.get_num_threads() == before
+    r2 = train(ENV, tiny(update_threads=1, n_workers=1))
+    assert _learning_stats(r1.history) == _learning_stats(r2.history)
+    _assert_same_model(_params(r1.model), _params(r2.model))
+    assert len(r1.history["hook_s"]) == r1.iterations and r1.startup_s > 0 and r1.checkpoint_s == 0.0
+    with pytest.raises(Exception, match=r"agent.update_threads=-1: must be an integer >= 0 \(0: torch's default\)"):
+        tiny(update_threads=-1).check()
