@@ -72,6 +72,10 @@ def ship(ref: str, name: str, store: Optional[str] = None, into: Optional[Any] =
     provenance = {"command": command, "run_id": run.info.run_id, "commit": tags.get("jt.git_commit", ""),
                   "samples": int(metrics.get("samples", -1)),
                   "train_wall_s": round(float(metrics.get("train_wall_s", float("nan"))), 1), "date": date}
+    keys = tuple(getattr(type(target.task), "key_metrics", ()))  # the run's own measure (e.g. every start phase)
+    own = {k: round(float(metrics[k]), 4) for k in keys if k in metrics and k not in ("samples",)}
+    if own:
+        provenance["metrics"] = own
     skill = Skill(name=name, task=target.task_name, folder=folder, overrides=overrides, point=target.point,
                   env_attrs=target.env_attrs, seed=int(target.seed),
                   description=description or kept or f"task={target.task_name} trained by run {run.info.run_id}",

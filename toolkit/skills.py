@@ -20,7 +20,8 @@ the registry finds them, so the core names no task. A skill is one folder of tha
 * ``seed``: the environment's seed;
 * ``measure``: what the replay reaches (the task's ``PolicyTask.play_summary``), documented;
 * ``provenance``: ``command``, ``run_id`` (in the store that trained it), ``commit``, ``samples``,
-  ``train_wall_s``, ``date``.
+  ``train_wall_s``, ``date``, and ``metrics``: the run's own measure (its task's key metrics: the spacetime
+  walk's survival from every start phase).
 
 ``toolkit.ship.ship(ref, name)`` (``jt play --ship RUN NAME``) writes such a folder from a run: the
 slim policy, the prior, the manifest from the run's command, tags and metrics, and its measure from

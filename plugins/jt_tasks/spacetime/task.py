@@ -34,7 +34,7 @@ from jt_tasks.spacetime.config import SpacetimeConfig
 class SpacetimeTask(PolicyTask):
     """Spacetime bounds (002): PPO inside bounds around a clip, evaluated as 002 Table 1."""
 
-    key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survived", "samples", "train_mean_length")
+    key_metrics: ClassVar[tuple[str, ...]] = ("survival_s", "survival_min_s", "survived", "samples", "train_mean_length")
     Config: ClassVar[type] = SpacetimeConfig
     env_path: ClassVar[str] = "jt_tasks.spacetime.env:SpacetimeEnv"
     #: ``jt play NAME``: the walk and run of ``experiment=laptop`` (Table 1's 20 s), a folder each
