@@ -28,12 +28,9 @@ def ship(ref: str, name: str, store: Optional[str] = None, into: Optional[Any] =
         into: the folder that gets ``<name>/``; None: the task's skills package.
         description: the manifest's one line; "" keeps the one already there, else names the run.
     """
-    import datetime
-    import shlex
     import shutil
 
-    from toolkit.rl.checkpoint import slim
-    from toolkit.skills import MANIFEST, NAME, POLICY, Skill, load_manifest, package_folder, write_manifest
+    from toolkit.skills import NAME, package_folder
 
     if not NAME.match(name):
         raise JtError(f"--ship {ref} {name}: a skill's name is letters, digits, '_', '-', '.'")
@@ -42,9 +39,7 @@ def ship(ref: str, name: str, store: Optional[str] = None, into: Optional[Any] =
     if is_path(ref):
         raise JtError(f"--ship {ref}: give the run's id (its command, commit and metrics come from the store)")
     target = from_run(ref, store)
-    run = target.run
-    tags = dict(run.data.tags)
-    command = tags.get("jt.command", "")
+    command = dict(target.run.data.tags).get("jt.command", "")
     if not command:
         raise JtError(f"--ship {ref}: the run has no jt.command tag (its overrides are unknown)")
     if into is None:
@@ -55,7 +50,27 @@ def ship(ref: str, name: str, store: Optional[str] = None, into: Optional[Any] =
     else:
         base = Path(into).expanduser()
     folder = (base / name).resolve()
+    fresh = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
+    try:
+        return _write(target, folder, name, command, description)
+    except BaseException:
+        if fresh:  # nothing half-written: a new skill's folder goes again
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
+
+
+def _write(target: Any, folder: Path, name: str, command: str, description: str) -> Skill:
+    """Write the skill's files from ``target`` (a run) into ``folder`` and measure it by a replay."""
+    import datetime
+    import shlex
+    import shutil
+
+    from toolkit.rl.checkpoint import slim
+    from toolkit.skills import MANIFEST, POLICY, Skill, load_manifest, write_manifest
+
+    run = target.run
+    tags = dict(run.data.tags)
     old = folder / MANIFEST
     kept = load_manifest(folder).description if old.is_file() and (folder / POLICY).is_file() else ""
     overrides = [o for o in shlex.split(command)[2:] if not o.startswith(("store=", "resume="))]

@@ -279,14 +279,28 @@ def write_manifest(skill: Skill) -> Path:
     """Write ``skill``'s ``manifest.yaml`` in its folder."""
     import yaml
 
-    data = {"name": skill.name, "task": skill.task, "description": skill.description,
-            "overrides": list(skill.overrides), "point": dict(skill.point), "env_attrs": dict(skill.env_attrs),
-            "seed": int(skill.seed), "measure": dict(skill.measure), "provenance": dict(skill.provenance)}
+    data = _yaml_plain({"name": skill.name, "task": skill.task, "description": skill.description,
+                        "overrides": list(skill.overrides), "point": dict(skill.point),
+                        "env_attrs": dict(skill.env_attrs), "seed": int(skill.seed), "measure": dict(skill.measure),
+                        "provenance": dict(skill.provenance)})
     head = (f"# A trained skill shipped with jt: `jt play {skill.name}` replays it (toolkit/skills.py says what\n"
             f"# each field is; `jt play --ship RUN {skill.name}` rewrites this folder from a run).\n")
     path = skill.folder / MANIFEST
     path.write_text(head + yaml.safe_dump(data, sort_keys=False, width=120, allow_unicode=True))
     return path
+
+
+def _yaml_plain(value: Any) -> Any:
+    """``value`` with numpy arrays and scalars made lists, floats, ints and bools (YAML writes those:
+    a spacetime run's start-phase weights are an array)."""
+    if isinstance(value, dict):
+        return {str(k): _yaml_plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_yaml_plain(v) for v in value]
+    tolist = getattr(value, "tolist", None)
+    if callable(tolist):  # numpy arrays and scalars
+        return _yaml_plain(tolist())
+    return value
 
 
 def check_fits(policy: Path, env: Any, skill: Optional[Skill] = None, what: str = "") -> None:

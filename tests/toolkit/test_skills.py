@@ -110,12 +110,27 @@ def test_a_manifest_round_trips(fosbury_copy):
         (skill.overrides, skill.point, skill.env_attrs, skill.measure, skill.provenance)
 
 
+def test_numpy_values_are_written_as_plain_yaml(fosbury_copy):
+    """A run's environment attributes may be arrays (a spacetime run's start-phase weights): the
+    manifest holds them as lists and numbers, not as a YAML error."""
+    import numpy as np
+
+    skill = skills.load_manifest(fosbury_copy)
+    skill.env_attrs = {**skill.env_attrs, "start_sampling": {"probs": np.array([0.25, 0.75])},
+                       "level": np.int64(3), "on": np.bool_(True)}
+    skills.write_manifest(skill)
+    again = skills.load_manifest(fosbury_copy)
+    assert again.env_attrs["start_sampling"] == {"probs": [0.25, 0.75]}
+    assert again.env_attrs["level"] == 3 and again.env_attrs["on"] is True
+
+
 def test_jt_play_lists_the_skills():
     p = run_jt("play")
     assert p.returncode == 0, p.stderr
     lines = p.stdout.splitlines()
     assert lines[0].startswith("jt play NAME: replay a shipped skill")
     assert any(ln.split()[:2] == ["fosbury", "task=highjump"] for ln in lines[1:])
+    assert any(ln.split()[:2] == ["walk", "task=spacetime"] for ln in lines[1:])
 
 
 def test_jt_play_mistakes_are_one_line(tmp_path):

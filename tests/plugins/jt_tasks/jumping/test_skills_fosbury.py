@@ -133,3 +133,19 @@ def test_ship_makes_a_skill_from_a_run(trained_run, fosbury, tmp_path):
     from toolkit.rl.checkpoint import load_attrs
 
     assert load_attrs(again.policy)["slim"]
+
+
+def test_a_ship_that_fails_leaves_no_half_written_skill(trained_run, tmp_path, monkeypatch):
+    """A replay that fails after the policy was written (here: interrupted) takes the new folder
+    with it; a skill that was there before is left for the user."""
+    import toolkit.ship as ship_module
+
+    st, rid, _ = trained_run
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ship_module, "replay", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        ship_module.ship(rid, "flop", str(st.root), tmp_path / "skills")
+    assert not (tmp_path / "skills" / "flop").exists()
