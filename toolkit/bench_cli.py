@@ -245,8 +245,8 @@ def bench_rollout(
 
 @bench_app.command("evaluation", context_settings={"allow_extra_args": True, "ignore_unknown_options": True})
 def bench_evaluation(
-    overrides: Optional[List[str]] = typer.Argument(None, help="jt run's overrides (e.g. task=highjump "
-                                                    "search=single experiment=laptop)."),
+    overrides: Optional[List[str]] = typer.Argument(None, help="jt run's overrides (e.g. task=TASK "
+                                                    "experiment=laptop)."),
     store: Optional[Path] = typer.Option(None, "--store", help="The store to run in (a kept one reuses its pose "
                                          "prior); default: a fresh temporary one, removed after."),
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the breakdown as JSON here."),
@@ -265,8 +265,8 @@ def bench_evaluation(
     if dashed:
         raise JtError(f"no such option: {dashed[0]} (see: jt bench evaluation --help)")
     if not extra:
-        raise JtError("jt bench evaluation needs jt run's overrides, e.g.: jt bench evaluation task=highjump "
-                      "search=single experiment=laptop")
+        raise JtError("jt bench evaluation needs jt run's overrides, e.g.: jt bench evaluation task=TASK "
+                      "experiment=laptop")
     from toolkit.config import compose
 
     compose(extra)  # a mistake is one line before anything runs

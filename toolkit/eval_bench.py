@@ -18,7 +18,7 @@ Phases (summed over the run's evaluations):
 * ``train, other``: the rest of training (the worker pool's start and close);
 * ``final rollout``, ``pictures`` (its GIF and ``rollout.h5``), ``measure`` (the task's measures);
 * ``evaluation, other``: the rest of each evaluation (environment spec, checkpoint loads);
-* ``prior``: a pose prior trained on first use;
+* ``prior``: other runs the command made first (a pose prior trained on first use);
 * ``outside evaluations``: process start, imports, composition, the store, the search and its
   summary (the command's wall time less everything above).
 """
@@ -80,14 +80,16 @@ def _read(store: Path, since_ms: float, wall: float) -> dict[str, Any]:
     from toolkit.store.opening import open_store
 
     client = open_store(store, must_exist=True).client
-    names = {e.experiment_id: e.name for e in client.search_experiments()}
-    runs = client.search_runs(list(names), filter_string=f"attributes.start_time >= {int(since_ms)}",
+    ids = [e.experiment_id for e in client.search_experiments()]
+    runs = client.search_runs(ids, filter_string=f"attributes.start_time >= {int(since_ms)}",
                               max_results=10000)
     evals = [r for r in runs if "time_train_s" in r.data.metrics]
     if not evals:
         raise JtError(f"jt bench evaluation: the run recorded no evaluation with a time breakdown in {store}")
-    priors = [r for r in runs if names.get(r.info.experiment_id) == "pose_prior" and r.info.end_time]
-    outer = [r for r in runs if "mlflow.parentRunId" not in r.data.tags and r not in priors]
+    parents = {r.data.tags.get("mlflow.parentRunId") for r in evals} - {None}
+    main = [r for r in runs if r.info.run_id in parents or (r in evals and "mlflow.parentRunId" not in r.data.tags)]
+    mine = {r.info.run_id for r in evals} | {r.info.run_id for r in main}
+    priors = [r for r in runs if r.info.run_id not in mine and r.info.end_time]  # e.g. a prior trained first
     phases: dict[str, float] = {}
 
     def add(name: str, seconds: float) -> None:
@@ -110,7 +112,7 @@ def _read(store: Path, since_ms: float, wall: float) -> dict[str, Any]:
     add("outside evaluations", max(0.0, wall - sum(phases.values())))
     samples = sum(float(r.data.metrics.get("samples", 0.0)) for r in evals)
     eval_s = sum(float(r.data.metrics.get("eval_seconds", 0.0)) for r in evals)
-    run_id = outer[0].info.run_id if outer else evals[0].info.run_id
+    run_id = main[0].info.run_id if main else evals[0].info.run_id
     return {"run_id": run_id, "evaluations": len(evals), "samples": samples, "eval_s": eval_s, "phases": phases}
 
 

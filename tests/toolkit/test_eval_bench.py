@@ -12,8 +12,8 @@ from tests.conftest import one_line_error, run_jt
 
 def test_a_runs_wall_time_is_broken_into_its_phases(tmp_path):
     out = tmp_path / "b.json"
-    p = run_jt("bench", "evaluation", "task=runup", "experiment=smoke", "--store", str(tmp_path / "s"),
-               "--json", str(out), "--quiet", timeout=600)
+    p = run_jt("bench", "evaluation", "task=runup", "experiment=smoke", "action=pvae", "action.prior=auto",
+               "--store", str(tmp_path / "s"), "--json", str(out), "--quiet", timeout=600)
     assert p.returncode == 0, p.stderr[-800:]
     res = json.loads(out.read_text())
     ph = res["phases"]
@@ -21,10 +21,11 @@ def test_a_runs_wall_time_is_broken_into_its_phases(tmp_path):
     assert {"startup", "collect", "update", "hooks", "checkpoint", "final rollout", "pictures", "measure",
             "outside evaluations"} <= set(ph)
     assert ph["collect"] > 0 and ph["update"] > 0 and ph["final rollout"] > 0
+    assert ph["prior"] > 0  # the store had no P-VAE prior: the run trained one first
     assert sum(ph.values()) == pytest.approx(res["wall_s"], rel=1e-6)  # every second is in one phase
     assert 0 < res["eval_s"] < res["wall_s"]
     text = p.stdout
-    assert "jt run task=runup experiment=smoke  (run " in text and "total (wall)" in text
+    assert "jt run task=runup experiment=smoke action=pvae action.prior=auto  (run " in text and "total (wall)" in text
     assert "samples/s: " in text and "while collecting" in text
     # the evaluation's own metrics, as the store has them
     from toolkit.store.opening import open_store
@@ -37,7 +38,7 @@ def test_a_runs_wall_time_is_broken_into_its_phases(tmp_path):
 
 def test_bad_input_is_one_line(tmp_path):
     err = one_line_error(run_jt("bench", "evaluation"))
-    assert "needs jt run's overrides, e.g.: jt bench evaluation task=highjump" in err
+    assert "needs jt run's overrides, e.g.: jt bench evaluation task=TASK experiment=laptop" in err
     err = one_line_error(run_jt("bench", "evaluation", "task=runup", "store=/tmp/x"))
     assert "give the store with --store, not store=" in err
     err = one_line_error(run_jt("bench", "evaluation", "task=nosuch"))
