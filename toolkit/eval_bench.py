@@ -1,7 +1,7 @@
 """``jt bench evaluation``: where one ``jt run``'s wall time goes, phase by phase.
 
 ``breakdown(overrides, store)`` runs ``jt run <overrides> store=<store>`` in a fresh process (so
-its start is counted, as a user pays it), then reads from the store the ``time_*_s`` metrics each
+its start is counted, as a user pays it), then reads from the store the ``wall_*_s`` metrics each
 policy evaluation records (``toolkit.policy.history.time_breakdown``), its ``eval_seconds`` and
 samples, and the wall time of any pose prior the run trained first (``action.prior=auto``).
 ``format_breakdown`` prints the table: each phase's seconds, its share of the command's wall time,
@@ -35,9 +35,9 @@ from typing import Any, Callable, Optional
 from toolkit.errors import JtError
 
 PARTS = ("startup", "collect", "update", "hooks", "checkpoint")
-"""The parts of training each evaluation records as ``time_<part>_s``."""
+"""The parts of training each evaluation records as ``wall_<part>_s``."""
 AFTER = ("final_rollout", "pictures", "measure")
-"""The parts after training, ``time_<part>_s``."""
+"""The parts after training, ``wall_<part>_s``."""
 
 
 def breakdown(overrides: list[str], store: Path, echo: Optional[Callable[[str], None]] = None) -> dict[str, Any]:
@@ -83,7 +83,7 @@ def _read(store: Path, since_ms: float, wall: float) -> dict[str, Any]:
     ids = [e.experiment_id for e in client.search_experiments()]
     runs = client.search_runs(ids, filter_string=f"attributes.start_time >= {int(since_ms)}",
                               max_results=10000)
-    evals = [r for r in runs if "time_train_s" in r.data.metrics]
+    evals = [r for r in runs if "wall_collect_s" in r.data.metrics]
     if not evals:
         raise JtError(f"jt bench evaluation: the run recorded no evaluation with a time breakdown in {store}")
     parents = {r.data.tags.get("mlflow.parentRunId") for r in evals} - {None}
@@ -97,14 +97,14 @@ def _read(store: Path, since_ms: float, wall: float) -> dict[str, Any]:
 
     for r in evals:
         m = r.data.metrics
-        parts = {p: float(m.get(f"time_{p}_s", 0.0)) for p in PARTS}
+        parts = {p: float(m.get(f"wall_{p}_s", 0.0)) for p in PARTS}
         for p, s in parts.items():
             add(p, s)
-        add("train, other", max(0.0, float(m["time_train_s"]) - sum(parts.values())))
-        after = {p: float(m.get(f"time_{p}_s", 0.0)) for p in AFTER}
+        add("train, other", max(0.0, float(m["train_wall_s"]) - sum(parts.values())))
+        after = {p: float(m.get(f"wall_{p}_s", 0.0)) for p in AFTER}
         for p, s in after.items():
             add(p.replace("_", " "), s)
-        add("evaluation, other", max(0.0, float(m.get("eval_seconds", 0.0)) - float(m["time_train_s"]) -
+        add("evaluation, other", max(0.0, float(m.get("eval_seconds", 0.0)) - float(m["train_wall_s"]) -
                                      sum(after.values())))
     prior = sum((r.info.end_time - r.info.start_time) / 1000.0 for r in priors)
     if prior:

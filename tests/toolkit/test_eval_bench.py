@@ -1,5 +1,5 @@
 """``jt bench evaluation``: one ``jt run`` in a fresh process, its wall time broken into phases
-from the ``time_*_s`` metrics its evaluation recorded in a real store."""
+from the ``wall_*_s`` metrics its evaluation recorded in a real store."""
 
 from __future__ import annotations
 
@@ -32,8 +32,8 @@ def test_a_runs_wall_time_is_broken_into_its_phases(tmp_path):
 
     client = open_store(tmp_path / "s", must_exist=True).client
     m = client.get_run(res["run_id"]).data.metrics
-    parts = sum(m[f"time_{k}_s"] for k in ("startup", "collect", "update", "hooks", "checkpoint"))
-    assert parts <= m["time_train_s"] + 1e-6 and m["time_train_s"] < m["eval_seconds"]
+    parts = sum(m[f"wall_{k}_s"] for k in ("startup", "collect", "update", "hooks", "checkpoint"))
+    assert parts <= m["train_wall_s"] + 1e-6 and m["train_wall_s"] < m["eval_seconds"]
 
 
 def test_bad_input_is_one_line(tmp_path):

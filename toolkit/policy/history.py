@@ -69,7 +69,7 @@ def base_metrics(ro: Any, trained: Any) -> dict[str, float]:
 
 
 def time_breakdown(trained: Any, clock: list[float]) -> dict[str, float]:
-    """Where an evaluation's wall time went (s), as ``time_*_s`` metrics (``jt bench evaluation``).
+    """Where an evaluation's wall time went (s), as ``wall_*_s`` metrics (``jt bench evaluation``).
 
     Args:
         trained: ``toolkit.policy.train.Trained`` (its PPO history holds ``collect_s``,
@@ -78,21 +78,20 @@ def time_breakdown(trained: Any, clock: list[float]) -> dict[str, float]:
             and ``rollout.h5`` were written, after the task's ``measure``.
 
     Returns:
-        ``time_train_s`` (the whole of PPO's training, workers started and closed), its parts
-        ``time_startup_s``, ``time_collect_s``, ``time_update_s``, ``time_hooks_s`` (the task's
-        per-iteration hook: a curriculum's deterministic rollouts), ``time_checkpoint_s``; then
-        ``time_final_rollout_s``, ``time_pictures_s``, ``time_measure_s``.
+        ``wall_startup_s``, ``wall_collect_s``, ``wall_update_s``, ``wall_hooks_s`` (the task's
+        per-iteration hook: a curriculum's deterministic rollouts), ``wall_checkpoint_s``; then
+        ``wall_final_rollout_s``, ``wall_pictures_s``, ``wall_measure_s``.
     """
     res, hist = trained.result, trained.result.history
 
     def total(key: str) -> float:
         return float(np.nansum(np.asarray(hist.get(key, []), dtype=np.float64)))
 
-    return {"time_train_s": float(trained.wall_s), "time_startup_s": float(getattr(res, "startup_s", 0.0)),
-            "time_collect_s": total("collect_s"), "time_update_s": total("update_s"),
-            "time_hooks_s": total("hook_s"), "time_checkpoint_s": float(getattr(res, "checkpoint_s", 0.0)),
-            "time_final_rollout_s": clock[1] - clock[0], "time_pictures_s": clock[2] - clock[1],
-            "time_measure_s": clock[3] - clock[2]}
+    return {"wall_startup_s": float(getattr(res, "startup_s", 0.0)),
+            "wall_collect_s": total("collect_s"), "wall_update_s": total("update_s"),
+            "wall_hooks_s": total("hook_s"), "wall_checkpoint_s": float(getattr(res, "checkpoint_s", 0.0)),
+            "wall_final_rollout_s": clock[1] - clock[0], "wall_pictures_s": clock[2] - clock[1],
+            "wall_measure_s": clock[3] - clock[2]}
 
 
 def measured(ro: Any, trained: Any, metrics: Mapping[str, float],
