@@ -71,7 +71,8 @@ def breakdown(overrides: list[str], store: Path, echo: Optional[Callable[[str], 
     wall = time.perf_counter() - started
     if rc != 0:
         last = next((x for x in reversed(lines) if x.strip()), "(no output)")
-        raise JtError(f"jt bench evaluation: jt run failed (exit {rc}): {last.strip()[:300]}")
+        last = last.strip().removeprefix("jt: ")
+        raise JtError(f"jt bench evaluation: jt run failed (exit {rc}): {last[:300]}")
     return {"command": "jt run " + " ".join(overrides), "wall_s": wall, **_read(store, t0 * 1000.0, wall)}
 
 

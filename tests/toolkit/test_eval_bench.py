@@ -43,3 +43,10 @@ def test_bad_input_is_one_line(tmp_path):
     assert "give the store with --store, not store=" in err
     err = one_line_error(run_jt("bench", "evaluation", "task=nosuch"))
     assert "nosuch" in err
+
+
+def test_a_run_that_fails_is_one_line_with_its_reason(tmp_path):
+    (tmp_path / "a_file").write_text("not a store")
+    err = one_line_error(run_jt("bench", "evaluation", "task=runup", "experiment=smoke", "--quiet",
+                                "--store", str(tmp_path / "a_file")))
+    assert err.startswith("jt: jt bench evaluation: jt run failed (exit 2): store=") and "is a file, not a folder" in err
