@@ -32,6 +32,8 @@ def test_the_first_five_seconds_from_phase_0(skill, tmp_path):
     assert done.capped and done.measure["survival_s"] == pytest.approx(5.0, abs=0.05)
     assert done.line.startswith(f"{skill.name}: still up at 5.0") and "from clip phase 0.00" in done.line
     assert done.files[0].name == f"{skill.name}.gif" and done.size == (320, 240)
+    if play.mp4_writer():  # the README's install has imageio-ffmpeg (.[video])
+        assert [f.name for f in done.files] == [f"{skill.name}.gif", f"{skill.name}.mp4"]
 
 
 @pytest.mark.slow
