@@ -84,10 +84,21 @@ class TargetMap:
             axes.append(a), es.append(e), fs.append(np.cross(a, e))
         self.e = np.array(es).reshape(-1, 3)
         self.f = np.array(fs).reshape(-1, 3)
+        self._sph_dofs = self.sph_dofs.reshape(-1, 3)
 
     def __call__(self, features: np.ndarray) -> np.ndarray:
-        """PD targets ``(..., n_dof)`` from raw features ``(..., n_features)``."""
+        """PD targets ``(..., n_dof)`` from raw features ``(..., n_features)``: one pose (an env's
+        step) through the compiled kernel, a batch vectorised in numpy (the same bits)."""
         x = np.asarray(features, dtype=np.float64)
+        if x.ndim == 1:
+            from toolkit.motion.kernels import features_to_dofs_post, features_to_dofs_pre
+
+            quat, ys, xs = np.empty((len(self.sph), 4)), np.empty(len(self.cols)), np.empty(len(self.cols))
+            features_to_dofs_pre(np.ascontiguousarray(x), self.cols, self.sph, self.rev, self.e, self.f, rot.EPS,
+                                 quat, ys, xs)
+            out = np.empty(self.skeleton.n_dof)
+            features_to_dofs_post(quat, np.arctan2(ys, xs), self._sph_dofs, self.rev_dofs, out)
+            return out
         m = rot.sixd_to_matrix(x[..., self.cols])  # (..., n_joints, 3, 3)
         out = np.empty(x.shape[:-1] + (self.skeleton.n_dof,))
         lead = x.shape[:-1]

@@ -103,3 +103,26 @@ def test_vectorised_target_map_equals_the_motion_layer(pose_dataset):
     for x in (pose_dataset.train.features, noisy, noisy[7]):
         np.testing.assert_allclose(tm(x), HUMANOID.joints_to_dofs(features_to_joints(x, pose_dataset.layout)),
                                    atol=1e-12)
+
+
+def test_one_pose_through_the_compiled_kernel_has_the_bits_of_the_batched_path(pose_dataset):
+    """An env decodes one action per step through the compiled kernel: the same bits as numpy's
+    batched path (a last-digit change would change every trajectory), near the series branch, at
+    ``pi``, and for degenerate 6D blocks too."""
+    from toolkit.priors.model import TargetMap
+
+    tm = TargetMap(pose_dataset.layout)
+    rng = np.random.default_rng(0)
+    base = pose_dataset.train.features[:200]
+    x = np.concatenate([base, base + 0.3 * rng.standard_normal(base.shape), 3.0 * rng.standard_normal(base.shape)])
+    odd = np.repeat(base[:1], 4, axis=0)
+    cols = tm.cols.ravel()
+    odd[0, cols] = 0.0  # zero blocks: the fallback columns
+    odd[1, tm.cols[:, 3:].ravel()] = odd[1, tm.cols[:, :3].ravel()]  # parallel columns: the degenerate b2
+    odd[2, cols] = np.tile([1.0, 0, 0, 0, 1.0, 0], len(tm.cols))  # identity: the exp maps' series branch
+    odd[3, cols] = np.tile([-1.0, 0, 0, 0, -1.0, 0], len(tm.cols))  # a half turn about z: Shepperd's k = 2
+    x = np.concatenate([x, odd])
+    batched = tm(x)
+    one = np.array([tm(row) for row in x])
+    assert one.shape == (len(x), HUMANOID.n_dof)
+    assert np.array_equal(batched.view(np.uint64), one.view(np.uint64))
