@@ -24,7 +24,7 @@ def test_bench_rollout_reports_the_breakdown_and_collection(tmp_path):
     assert res.exit_code == 0, res.output
     assert "physics share" in res.output and "samples/s" in res.output
     # highjump's own config, its P-VAE action (which needs a prior) replaced by raw, and said so
-    assert "task=highjump action=raw (pvae needs a prior) sim.loop=auto (task's own: spd=df)" in res.output
+    assert "task=highjump action=raw (pvae needs a prior) sim.loop=auto (task's own: spd=maba)" in res.output
     data = json.loads(out.read_text())["results"][0]
     assert data["overrides"] == ["action=raw", "sim.loop=auto"] and data["training"] == []
     env = data["env"][0]
