@@ -169,4 +169,19 @@ def load_prior(ref: Any, store_root: Optional[str] = None, kind: Optional[str] =
     if text == "auto":
         raise JtError("action.prior=auto is resolved by jt run before a run opens (toolkit.priors.auto); "
                       f"outside jt run give a run id or a path; {how_to_make(kind or 'pvae')}")
-    return read_prior(_find(text, store_root, kind or "pvae"), kind)
+    where = (text, None if store_root is None else str(store_root), os.environ.get("JT_STORE"), kind)
+    found = _FOUND.get(where)
+    if found is None or not found.is_file():  # a run's artifacts do not move: look it up once per process
+        found = _FOUND[where] = _find(text, store_root, kind or "pvae")
+    key = (str(found), found.stat().st_mtime_ns, kind)
+    if key not in _LOADED:  # a rollout worker builds 16 envs from one prior: read and check it once
+        _LOADED.clear()
+        _LOADED[key] = read_prior(found, kind)
+    return _LOADED[key]
+
+
+_FOUND: dict[tuple, Path] = {}
+"""The file each ``action.prior`` reference resolved to (by reference, store, ``$JT_STORE``, kind)."""
+_LOADED: dict[tuple, PosePrior] = {}
+"""The last prior ``load_prior`` read, by (file, its mtime, kind); shared by the envs of a process
+(a ``PosePrior`` is not changed after loading)."""

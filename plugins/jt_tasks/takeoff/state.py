@@ -137,6 +137,10 @@ def impose(root_rot: np.ndarray, v: np.ndarray, w: np.ndarray, features: dict[st
     return rot.quat_rotate(hq, v_f), rot.quat_rotate(hq, w_f)
 
 
+_SUPPORT_TIMES: dict[tuple, float] = {}
+"""``support_phase_time`` by (clip file, its mtime, foot, tolerance): a rollout worker builds 16 envs."""
+
+
 def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str = "right",
                   omega_y: Optional[float] = 3.0, contact_tol: float = 0.06,
                   v_y: Optional[float] = None) -> TakeoffState:
@@ -163,7 +167,10 @@ def takeoff_state(features: dict[str, float], clip_name: str = "run", foot: str 
 
     path = clip_name if os.path.sep in clip_name else os.path.join(motions_dir(), f"humanoid3d_{clip_name}.txt")
     clip = load_clip(path)
-    t, _ = support_phase_time(clip, foot, contact_tol)
+    key = (os.path.abspath(path), os.path.getmtime(path), foot, float(contact_tol))
+    if key not in _SUPPORT_TIMES:  # the clip's forward kinematics: ~30 ms, once per process, not per env
+        _SUPPORT_TIMES[key] = support_phase_time(clip, foot, contact_tol)[0]
+    t = _SUPPORT_TIMES[key]
     p, r, j, v, w, jv = reference_state(clip, t)
     v, w = impose(r, v, w, features, omega_y, v_y)
     # turn the whole state about +y so the heading is +x, and put the root above the origin
