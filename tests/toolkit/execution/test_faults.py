@@ -384,7 +384,8 @@ def test_closing_the_terminal_stops_the_run_at_a_safe_point(example_plugin, temp
     proc = subprocess.Popen([sys.executable, "-m", "toolkit.cli", "run", "task=quadratic", "search=random",
                              "search.batch=2", "search.budget=2", "executor.workers=2", "task.sleep=30",
                              f"store={store}"], env=jt_env(example_plugin), stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_hangup_default)  # a suite started under nohup would pass SIG_IGN on
     try:
         rid = _wait("the run's row", lambda: _outer_ids(store))[0]
         _wait("both evaluations", lambda: len(_query(store, "select name from runs where status = 'RUNNING' and "
@@ -404,7 +405,21 @@ def test_closing_the_terminal_stops_the_run_at_a_safe_point(example_plugin, temp
     assert _query(store, "select name from runs where status = 'RUNNING'") == []
 
 
-def test_sighup_is_a_request_unless_it_is_ignored():
+def _hangup_default() -> None:
+    """SIGHUP's default disposition in a child: the test is of a terminal closing, not of nohup's."""
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
+
+@pytest.fixture
+def hangup_default():
+    """SIGHUP at its default while a test runs (a suite started under nohup inherits SIG_IGN, which
+    ``stopping.Terminate`` rightly leaves alone); the inherited disposition restored after."""
+    inherited = signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    yield
+    signal.signal(signal.SIGHUP, inherited)
+
+
+def test_sighup_is_a_request_unless_it_is_ignored(hangup_default):
     from toolkit.execution import stopping
 
     with stopping.Terminate():
